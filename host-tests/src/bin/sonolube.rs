@@ -1,0 +1,6 @@
+//! `sonolube`: the host command-line tool.
+
+fn main() {
+    eprintln!("usage: sonolube <command> ...");
+    std::process::exit(2);
+}

@@ -1,0 +1,7 @@
+//! Host side of Sonolube.
+//!
+//! Everything here runs on the development machine only: the independent f64 reference
+//! model (written from the papers, never calling the fixed-point code), and the
+//! command-line tool's building blocks.
+
+pub mod reference;

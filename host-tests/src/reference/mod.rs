@@ -1,0 +1,1 @@
+//! Independent double-precision reference of the friction model (host only).

@@ -1,0 +1,1 @@
+//! Fixed-point arithmetic: formats and elementary functions used by the model's hot path.

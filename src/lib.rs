@@ -1,0 +1,10 @@
+//! Sonolube pure logic: everything that does not touch hardware.
+//!
+//! `no_std`, no heap, no HAL imports. The same code runs in the firmware (boards in `board/`)
+//! and on the host (unit tests here, integration tests and tools in `host-tests/`).
+#![cfg_attr(not(test), no_std)]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+pub mod fx;
+pub mod selfcheck;
