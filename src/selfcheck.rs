@@ -99,12 +99,20 @@ impl PeriodMonitor {
 
     /// Shortest interval seen, in ticks (`None` before the second wake-up).
     pub const fn min_interval(&self) -> Option<u64> {
-        if self.intervals == 0 { None } else { Some(self.min_interval) }
+        if self.intervals == 0 {
+            None
+        } else {
+            Some(self.min_interval)
+        }
     }
 
     /// Longest interval seen, in ticks (`None` before the second wake-up).
     pub const fn max_interval(&self) -> Option<u64> {
-        if self.intervals == 0 { None } else { Some(self.max_interval) }
+        if self.intervals == 0 {
+            None
+        } else {
+            Some(self.max_interval)
+        }
     }
 
     /// Number of intervals longer than the period plus the allowed lateness.
@@ -229,9 +237,6 @@ mod tests {
         for k in 0..=50u64 {
             m.record(k * 985 + if k % 2 == 0 { 0 } else { 9 });
         }
-        assert_eq!(
-            m.verdict(50),
-            PeriodVerdict::MeanOff { mean_interval: 985 }
-        );
+        assert_eq!(m.verdict(50), PeriodVerdict::MeanOff { mean_interval: 985 });
     }
 }

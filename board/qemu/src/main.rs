@@ -1,1 +1,105 @@
-fn main() {}
+//! Sonolube firmware for QEMU's mps2-an386 (Cortex-M4F at 25 MHz): the simulated board.
+//!
+//! Boots, starts the SysTick time driver and a WFI executor, and runs the application's tasks
+//! (see `sonolube_app`). The run's verdict is the exit status of QEMU (see `exit.rs`).
+//!
+//! Test builds (cargo features) fail on purpose half-way through the run, so that the test
+//! command can check each failure is reported: `fail-selfcheck` stalls the heartbeat once (the
+//! self-check must fail), `hang` blocks the executor forever (the runner's timeout must end the
+//! run), `panic-test` enables the drive and panics (the drive must be safe before the report).
+#![no_std]
+#![no_main]
+
+mod drive;
+mod executor;
+mod exit;
+mod time_driver;
+
+use defmt_semihosting as _;
+use embassy_executor::raw;
+use embassy_time::{Duration, Instant};
+use sonolube_app::{Board, heartbeat};
+use static_cell::StaticCell;
+
+defmt::timestamp!("{=u64:us}", Instant::now().as_micros());
+
+/// The QEMU mps2-an386 board.
+struct Qemu;
+
+impl Board for Qemu {
+    const NAME: &'static str = "qemu mps2-an386";
+
+    fn drive_safe() {
+        drive::force_safe();
+    }
+
+    fn finish(passed: bool) -> ! {
+        exit::exit(if passed {
+            exit::PASS
+        } else {
+            exit::SELFCHECK_FAILED
+        })
+    }
+}
+
+/// In test builds, fails in the way the build's feature names, half-way through the run.
+fn inject_test_failure(wakeups: u32) {
+    const AT: u32 = heartbeat::WAKEUPS_PER_REPORT * heartbeat::REPORTS / 2;
+    if wakeups != AT {
+        return;
+    }
+    if cfg!(feature = "fail-selfcheck") {
+        defmt::warn!("test build: stalling the heartbeat for 3 ms");
+        embassy_time::block_for(Duration::from_millis(3));
+    }
+    if cfg!(feature = "panic-test") {
+        drive::set(u32::MAX / 4);
+        defmt::warn!("test build: drive {} and panicking", drive::state());
+        panic!("deliberate panic after {} heartbeats", wakeups);
+    }
+    if cfg!(feature = "hang") {
+        defmt::warn!("test build: blocking the executor forever");
+        #[allow(clippy::empty_loop)]
+        loop {}
+    }
+}
+
+#[embassy_executor::task]
+async fn heartbeat_task() {
+    heartbeat::heartbeat(inject_test_failure).await
+}
+
+#[embassy_executor::task]
+async fn supervisor_task() {
+    heartbeat::supervisor::<Qemu>().await
+}
+
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    Qemu::drive_safe();
+    let Some(core) = cortex_m::Peripherals::take() else {
+        exit::exit(exit::FAULT);
+    };
+    time_driver::init(core.SYST);
+    defmt::info!(
+        "sonolube {} on {}, core clock {=u64} Hz",
+        env!("CARGO_PKG_VERSION"),
+        Qemu::NAME,
+        time_driver::CORE_CLOCK_HZ
+    );
+
+    static EXECUTOR: StaticCell<raw::Executor> = StaticCell::new();
+    let executor = EXECUTOR.init(raw::Executor::new(core::ptr::null_mut()));
+    executor::run(executor, |spawner| {
+        match (heartbeat_task(), supervisor_task()) {
+            (Ok(heartbeat), Ok(supervisor)) => {
+                spawner.spawn(heartbeat);
+                spawner.spawn(supervisor);
+            }
+            _ => {
+                defmt::error!("could not spawn the tasks");
+                exit::exit(exit::FAULT);
+            }
+        }
+    })
+}

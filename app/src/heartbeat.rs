@@ -1,0 +1,86 @@
+//! Boot self-check: a periodic heartbeat task timed by a supervisor task.
+//!
+//! `heartbeat` wakes on an `embassy_time::Ticker`, timestamps each wake-up into a
+//! [`PeriodMonitor`], and every [`WAKEUPS_PER_REPORT`] wake-ups sends its statistics over a
+//! channel. `supervisor` logs each report and, after [`REPORTS`] of them, judges the run: it
+//! proves that the time driver, the executor and the channel work together before anything is
+//! allowed to drive the transducer.
+
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_sync::channel::Channel;
+use embassy_time::{Duration, Instant, Ticker};
+use sonolube::selfcheck::{PeriodMonitor, PeriodVerdict};
+
+use crate::Board;
+
+/// Heartbeat rate, in Hz.
+pub const HEARTBEAT_HZ: u64 = 1_000;
+/// The heartbeat reports every this many wake-ups.
+pub const WAKEUPS_PER_REPORT: u32 = 100;
+/// Reports the supervisor waits for before judging the run.
+pub const REPORTS: u32 = 5;
+/// Largest lateness of one wake-up that still passes, in microseconds.
+pub const MAX_LATE_US: u64 = 20;
+
+/// What the heartbeat tells the supervisor.
+#[derive(Clone, Copy)]
+pub struct Report {
+    /// Wake-ups so far.
+    pub wakeups: u32,
+    /// Timing statistics so far.
+    pub monitor: PeriodMonitor,
+}
+
+static REPORTS_CHANNEL: Channel<CriticalSectionRawMutex, Report, 2> = Channel::new();
+
+/// The heartbeat task body. `on_wakeup` is called with the wake-up count after each wake-up
+/// (boards use it to inject failures in test builds); it may block.
+pub async fn heartbeat(mut on_wakeup: impl FnMut(u32)) -> ! {
+    let period = Duration::from_hz(HEARTBEAT_HZ);
+    let mut ticker = Ticker::every(period);
+    let mut monitor = PeriodMonitor::new(
+        period.as_ticks(),
+        Duration::from_micros(MAX_LATE_US).as_ticks(),
+    );
+    let mut wakeups: u32 = 0;
+    loop {
+        ticker.next().await;
+        monitor.record(Instant::now().as_ticks());
+        wakeups = wakeups.saturating_add(1);
+        on_wakeup(wakeups);
+        if wakeups.is_multiple_of(WAKEUPS_PER_REPORT) {
+            REPORTS_CHANNEL.send(Report { wakeups, monitor }).await;
+        }
+    }
+}
+
+/// The supervisor task body: logs the heartbeat's reports, then ends the run with the verdict.
+pub async fn supervisor<B: Board>() -> ! {
+    let mut last: Option<Report> = None;
+    for _ in 0..REPORTS {
+        let report = REPORTS_CHANNEL.receive().await;
+        let m = &report.monitor;
+        defmt::info!(
+            "heartbeat: {=u32} wake-ups, interval min {=u64} max {=u64} ticks, {=u32} overruns",
+            report.wakeups,
+            m.min_interval().unwrap_or(0),
+            m.max_interval().unwrap_or(0),
+            m.overruns()
+        );
+        last = Some(report);
+    }
+    let verdict = match last {
+        Some(report) => report.monitor.verdict(report.wakeups.saturating_sub(1)),
+        None => PeriodVerdict::TooFewIntervals {
+            seen: 0,
+            required: 1,
+        },
+    };
+    if verdict == PeriodVerdict::Pass {
+        defmt::info!("self-check passed on {}: {}", B::NAME, verdict);
+        B::finish(true)
+    } else {
+        defmt::error!("self-check FAILED on {}: {}", B::NAME, verdict);
+        B::finish(false)
+    }
+}
