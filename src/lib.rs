@@ -7,4 +7,5 @@
 #![deny(missing_docs)]
 
 pub mod fx;
+pub mod protocol;
 pub mod selfcheck;

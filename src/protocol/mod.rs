@@ -1,0 +1,1 @@
+//! The command and telemetry line protocol spoken over the UART.
