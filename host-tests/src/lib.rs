@@ -4,4 +4,5 @@
 //! model (written from the papers, never calling the fixed-point code), and the
 //! command-line tool's building blocks.
 
+pub mod papers;
 pub mod reference;
