@@ -1,1 +1,178 @@
 //! The command and telemetry line protocol spoken over the UART.
+//!
+//! Everything is text, one line per message, `\n`-terminated, printable ASCII only, so a person
+//! can use a serial terminal and a program can parse every line. The host sends commands; the
+//! firmware answers every non-empty command line with exactly one reply line, in order, and
+//! sends telemetry lines in between when telemetry is on. The first word tells them apart:
+//! `ok` and `err` are replies, `tel` is telemetry.
+//!
+//! Numbers are exact decimal fixed-point: no floats are parsed or printed anywhere (see
+//! [`parse_decimal`]). Values are carried as scaled integers with the unit in the field name
+//! (`force_mn`, `coef_ppm`, `freq_chz`).
+//!
+//! # Flow in the firmware
+//!
+//! 1. Feed received bytes into a [`LineAssembler`]; it yields each complete line, or the error
+//!    of a line that was too long or held a non-ASCII or control byte (once, at its newline).
+//! 2. [`parse_command`] turns a line into a [`Command`] or a [`ProtocolError`].
+//! 3. Execute the command; reply with [`format_ack`], [`format_status`], [`format_faults`],
+//!    [`format_version`], [`format_scene_list`] or [`OkReply`], or with [`format_error`] (a
+//!    parse error, or an execution error such as [`ProtocolError::WrongState`]).
+//! 4. At the telemetry rate, [`format_telemetry`] a [`TelemetryRecord`].
+//!
+//! The host tool does the reverse: [`format_command`] to send, [`parse_incoming`] (or
+//! [`parse_reply`] and [`parse_telemetry`]) to read.
+//!
+//! # Lines
+//!
+//! A line is at most [`MAX_LINE_LEN`] (96) bytes before its terminator. `\n` ends a line, `\r`
+//! is ignored (so `\r\n` works), tabs count as spaces, and any other byte outside
+//! `0x20..=0x7e` makes the line a `bad-encoding` error. Empty and blank lines get no reply.
+//! Words are separated by one or more spaces or tabs; keywords are lowercase and
+//! case-sensitive.
+//!
+//! # Commands
+//!
+//! | command | argument range and resolution | effect | `ok` reply (example) |
+//! |---|---|---|---|
+//! | `version` | | firmware and protocol version | `ok firmware=0.1.0 board=qemu protocol=1` |
+//! | `status` | | state, target and measurements | `ok state=running scene=demo target=force:12.500 mu=0.312000 normal_n=40.000 tangential_n=12.480 amp=0.523000 freq_hz=40000.00 overruns=0 lost=0 fault=none` |
+//! | `faults` | | latched and active faults | `ok latched=overcurrent active=none` |
+//! | `target force <N>` | `0 < N <= 50000` newtons, 0.001 N | hold this friction force | `ok target=force:12.500` |
+//! | `target coef <mu>` | `0 < mu <= 2`, 0.000001 | hold this friction coefficient | `ok target=coef:0.350000` |
+//! | `target reduction <r>` | `0 <= r < 100` percent, 0.001 % | hold this reduction of the natural friction | `ok target=reduction:40.000` |
+//! | `scene list` | | names of the scenes | `ok count=2 scenes=demo,ramp` |
+//! | `scene <name>` | `[a-z0-9_-]`, 1 to 24 bytes, not `list` or `none` | select a scene | `ok scene=demo` |
+//! | `start` | | drive on, close the friction loop | `ok` |
+//! | `stop` | | open the loop, drive off | `ok` |
+//! | `freq <Hz>` | `20000 <= f <= 60000` hertz, 0.01 Hz | fixed drive frequency | `ok freq_hz=40000.00` |
+//! | `freq auto` | | search the resonance and drive there | `ok freq_hz=auto` |
+//! | `tare normal\|tangential\|all` | | zero force sensors (no load) | `ok tare=all` |
+//! | `cal normal\|tangential <N>` | `0 < N <= 50000` newtons, 0.001 N | set a sensor's gain from a known load | `ok cal=normal load_n=10.000` |
+//! | `clear` | | clear the latched fault | `ok` |
+//! | `telemetry <Hz>` | `1 <= rate <= 10000` hertz, 1 Hz | send telemetry at this rate | `ok telemetry_hz=100` |
+//! | `telemetry off` | | stop telemetry | `ok telemetry_hz=off` |
+//! | `help` | | list the commands | `ok commands=version,status,faults,target,scene,start,stop,freq,tare,cal,clear,telemetry,help` |
+//!
+//! Numbers are `[+-]digits[.digits]`: at least one digit before a `.` and one after it, no
+//! exponent, no unit, at most 12 digits in all. A value is never rounded: a non-zero digit
+//! finer than the resolution is `too-many-decimals`, but zeros past it are accepted (`12.5000`
+//! is 12.500 N). A sign is accepted on every number, so `-5` is `out-of-range` rather than
+//! `bad-number`. For `freq` and `telemetry` an argument that starts with a digit, sign or `.`
+//! is read as a number, anything else must be the word (`auto`, `off`).
+//!
+//! # Replies
+//!
+//! `ok` is followed by zero or more `key=value` pairs separated by single spaces. Keys are
+//! lowercase, with the unit as a suffix where there is one (`normal_n` in newtons, `freq_hz`
+//! in hertz); values contain no space, `=`, `,`, `:` or `"`, except that lists are
+//! comma-separated (`none` when empty) and targets are `kind:value` (`none` when unset).
+//! Status fields: `state` (see [`SupervisorState`]), `scene`, `target`, `mu` (friction
+//! coefficient estimate), `normal_n` and `tangential_n` (forces, N, 3 decimals), `amp` (drive
+//! amplitude as a fraction of full scale, 6 decimals), `freq_hz` (2 decimals), `overruns`,
+//! `lost` (telemetry records lost) and `fault` (latched fault or `none`).
+//!
+//! An error is `err <code> <name> <message>`: a stable number, its kebab-case name, and a
+//! message for a person that quotes the offending word and states the rule, for example
+//! `err 6 out-of-range "60001" is out of range 20000.00 <= freq <= 60000.00 Hz`.
+//!
+//! | code | name | meaning |
+//! |---|---|---|
+//! | 1 | `unknown-command` | the first word is not a command |
+//! | 2 | `bad-number` | not of the form `[+-]digits[.digits]` (`abc`, `.5`, `1.2.3`) |
+//! | 3 | `trailing-garbage` | a number followed by other characters (`12N`, `1e3`) |
+//! | 4 | `too-many-digits` | more than 12 digits |
+//! | 5 | `too-many-decimals` | a non-zero digit finer than the resolution |
+//! | 6 | `out-of-range` | outside the range of the table above |
+//! | 7 | `missing-argument` | the command needs more arguments |
+//! | 8 | `extra-argument` | more arguments than the command takes |
+//! | 9 | `bad-choice` | an argument that is not one of the allowed words |
+//! | 10 | `bad-name` | not a valid scene name |
+//! | 11 | `line-too-long` | more than 96 bytes before the newline; the line is discarded |
+//! | 12 | `bad-encoding` | a byte that is not printable ASCII or tab; the line is discarded |
+//! | 13 | `empty-line` | no command on the line (only from a direct parser call) |
+//! | 20 | `unknown-scene` | no scene has this name |
+//! | 21 | `wrong-state` | the command is not allowed in the current state |
+//! | 22 | `fault-latched` | a fault is latched; send `clear` first |
+//! | 23 | `no-target` | `start` without a target |
+//! | 24 | `cal-failed` | the calibration could not be completed |
+//!
+//! Codes 1 to 13 come from this module; codes 20 to 24 are for the firmware to return when a
+//! well-formed command cannot be executed. A code never changes meaning; new codes get new
+//! numbers.
+//!
+//! # Telemetry
+//!
+//! One line per record, fields always present and always in this order:
+//!
+//! ```text
+//! tel t_us=1250000 seq=12500 state=running target=force:12.500 mu=0.312000 normal_n=40.000 tangential_n=12.480 amp=0.523000 freq_hz=40000.00 overruns=0 lost=0
+//! ```
+//!
+//! | key | field | unit and format | range on the wire |
+//! |---|---|---|---|
+//! | `t_us` | time of the sample since boot | µs, integer | `0..=18446744073709551615` |
+//! | `seq` | record number, +1 per record produced (sent or lost), wrapping | integer | `0..=4294967295` |
+//! | `state` | supervisor state | `boot`, `idle`, `tuning`, `calibrating`, `running`, `fault` | |
+//! | `target` | friction target | `force:<N, 3 decimals>`, `coef:<6 decimals>`, `reduction:<%, 3 decimals>` or `none` | value `0..=u32::MAX` scaled units |
+//! | `mu` | friction coefficient estimate | 6 decimals (ppm) | `0.000000..=4294.967295` |
+//! | `normal_n` | normal force | N, 3 decimals (mN), signed | `-2147483.648..=2147483.647` |
+//! | `tangential_n` | tangential (friction) force | N, 3 decimals (mN), signed | `-2147483.648..=2147483.647` |
+//! | `amp` | drive amplitude, fraction of full scale (1.000000 = full) | 6 decimals (ppm) | `0.000000..=4294.967295` |
+//! | `freq_hz` | drive frequency | Hz, 2 decimals (cHz) | `0.00..=42949672.95` |
+//! | `overruns` | control-loop overruns since boot | integer | `0..=4294967295` |
+//! | `lost` | telemetry records lost since boot (UART busy) | integer | `0..=4294967295` |
+//!
+//! The longest record is 227 bytes with its newline ([`TELEMETRY_CAPACITY`] is 256). A gap in
+//! `seq` with a matching increase of `lost` means records were dropped, not corrupted.
+
+mod code;
+mod command;
+mod decode;
+mod error;
+mod line;
+mod name;
+mod number;
+mod parse;
+mod quantity;
+mod reply;
+mod report;
+mod state;
+mod target;
+mod telemetry;
+mod text;
+
+#[cfg(test)]
+mod props;
+
+pub use code::ErrorCode;
+pub use command::{Axis, Command, KEYWORDS, TareAxes, format_command};
+pub use decode::{DecodeError, ErrorReply, Incoming, Payload, Reply, parse_incoming, parse_reply};
+pub use error::{MAX_QUOTED_TOKEN_LEN, MAX_REASON_LEN, ProtocolError, TokenText};
+pub use line::{LineAssembler, MAX_LINE_LEN};
+pub use name::{MAX_SCENE_NAME_LEN, RESERVED_SCENE_NAMES, SceneName, is_scene_name};
+pub use number::{
+    MAX_COMMAND_DIGITS, MAX_DECODE_DIGITS, NumberError, decode_i32, decode_u32, decode_u64,
+    parse_decimal,
+};
+pub use parse::parse_command;
+pub use quantity::{
+    ALL_QUANTITIES, CAL_LOAD, DRIVE_FREQ, Quantity, TARGET_COEF, TARGET_FORCE, TARGET_REDUCTION,
+    TELEMETRY_RATE,
+};
+pub use reply::{NONE, OkReply, REPLY_CAPACITY, format_ack, format_error};
+pub use report::{
+    FaultReport, StatusReport, VersionReport, format_faults, format_help, format_scene_list,
+    format_status, format_version,
+};
+pub use state::SupervisorState;
+pub use target::{NO_TARGET, Target, TargetDecodeError, decode_target};
+pub use telemetry::{
+    TELEMETRY_CAPACITY, TELEMETRY_TAG, TelemetryRecord, format_telemetry, parse_telemetry,
+};
+pub use text::{FormatError, MAX_DECIMALS, MAX_WORD_LEN, is_word};
+
+/// Version of this protocol, reported by `version`. Bumped when a line that one side sends
+/// could be read differently by the other (a new field, state or keyword); new error codes and
+/// commands that old hosts never send do not bump it.
+pub const PROTOCOL_VERSION: u16 = 1;
