@@ -6,6 +6,8 @@
 //! proves that the time driver, the executor and the channel work together before anything is
 //! allowed to drive the transducer.
 
+use core::sync::atomic::{AtomicU32, Ordering};
+
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_time::{Duration, Instant, Ticker};
@@ -33,6 +35,15 @@ pub struct Report {
 
 static REPORTS_CHANNEL: Channel<CriticalSectionRawMutex, Report, 2> = Channel::new();
 
+/// Wake-ups of the heartbeat so far: a watchdog keeper feeds the watchdog only while this
+/// advances, so a stalled heartbeat (or executor) ends in a watchdog reset.
+static ALIVE: AtomicU32 = AtomicU32::new(0);
+
+/// Number of heartbeat wake-ups so far (wraps).
+pub fn alive_count() -> u32 {
+    ALIVE.load(Ordering::Relaxed)
+}
+
 /// The heartbeat task body. `on_wakeup` is called with the wake-up count after each wake-up
 /// (boards use it to inject failures in test builds); it may block.
 pub async fn heartbeat(mut on_wakeup: impl FnMut(u32)) -> ! {
@@ -47,6 +58,7 @@ pub async fn heartbeat(mut on_wakeup: impl FnMut(u32)) -> ! {
         ticker.next().await;
         monitor.record(Instant::now().as_ticks());
         wakeups = wakeups.saturating_add(1);
+        ALIVE.fetch_add(1, Ordering::Relaxed);
         on_wakeup(wakeups);
         if wakeups.is_multiple_of(WAKEUPS_PER_REPORT) {
             REPORTS_CHANNEL.send(Report { wakeups, monitor }).await;

@@ -16,20 +16,26 @@ pub enum SupervisorState {
     Tuning,
     /// `calibrating`: `tare` or `cal` in progress, drive off.
     Calibrating,
+    /// `ramp-up`: soft start, drive amplitude rising at a limited rate toward the loop's output.
+    RampUp,
     /// `running`: drive on, friction loop closed.
     Running,
+    /// `ramp-down`: drive amplitude falling at a limited rate to zero (stop, or no sliding).
+    RampDown,
     /// `fault`: a fault is latched, drive in its safe state until `clear`.
     Fault,
 }
 
 impl SupervisorState {
     /// Every state, in the order of the table above.
-    pub const ALL: [SupervisorState; 6] = [
+    pub const ALL: [SupervisorState; 8] = [
         SupervisorState::Boot,
         SupervisorState::Idle,
         SupervisorState::Tuning,
         SupervisorState::Calibrating,
+        SupervisorState::RampUp,
         SupervisorState::Running,
+        SupervisorState::RampDown,
         SupervisorState::Fault,
     ];
 
@@ -40,7 +46,9 @@ impl SupervisorState {
             SupervisorState::Idle => "idle",
             SupervisorState::Tuning => "tuning",
             SupervisorState::Calibrating => "calibrating",
+            SupervisorState::RampUp => "ramp-up",
             SupervisorState::Running => "running",
+            SupervisorState::RampDown => "ramp-down",
             SupervisorState::Fault => "fault",
         }
     }

@@ -11,6 +11,8 @@ use crate::drive;
 pub const PASS: i32 = 0;
 /// Exit status of a run whose self-check failed.
 pub const SELFCHECK_FAILED: i32 = 1;
+/// Exit status of the boot that follows a watchdog reset.
+pub const WATCHDOG_RESET: i32 = 2;
 /// Exit status after a HardFault or an unexpected exception.
 pub const FAULT: i32 = 3;
 /// Exit status after a panic (the same number a panicking Rust program uses on a host).

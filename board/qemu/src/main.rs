@@ -3,10 +3,15 @@
 //! Boots, starts the SysTick time driver and a WFI executor, and runs the application's tasks
 //! (see `sonolube_app`). The run's verdict is the exit status of QEMU (see `exit.rs`).
 //!
+//! A watchdog keeper feeds the CMSDK watchdog only while the heartbeat advances; a stalled
+//! heartbeat gets an NMI (drive safe) and then a reset, and the next boot reports it.
+//!
 //! Test builds (cargo features) fail on purpose half-way through the run, so that the test
 //! command can check each failure is reported: `fail-selfcheck` stalls the heartbeat once (the
-//! self-check must fail), `hang` blocks the executor forever (the runner's timeout must end the
-//! run), `panic-test` enables the drive and panics (the drive must be safe before the report).
+//! self-check must fail), `hang` blocks the executor forever with the watchdog off (the runner's
+//! timeout must end the run), `watchdog-test` blocks it with the watchdog on (the watchdog must
+//! reset the machine and the next boot must report it), `panic-test` enables the drive and
+//! panics (the drive must be safe before the report).
 #![no_std]
 #![no_main]
 
@@ -14,6 +19,7 @@ mod drive;
 mod executor;
 mod exit;
 mod time_driver;
+mod watchdog;
 
 use defmt_semihosting as _;
 use embassy_executor::raw;
@@ -57,7 +63,7 @@ fn inject_test_failure(wakeups: u32) {
         defmt::warn!("test build: drive {} and panicking", drive::state());
         panic!("deliberate panic after {} heartbeats", wakeups);
     }
-    if cfg!(feature = "hang") {
+    if cfg!(any(feature = "hang", feature = "watchdog-test")) {
         defmt::warn!("test build: blocking the executor forever");
         #[allow(clippy::empty_loop)]
         loop {}
@@ -67,6 +73,23 @@ fn inject_test_failure(wakeups: u32) {
 #[embassy_executor::task]
 async fn heartbeat_task() {
     heartbeat::heartbeat(inject_test_failure).await
+}
+
+/// Watchdog timeout: an NMI after this long without progress of the heartbeat, a reset after
+/// twice this long.
+const WATCHDOG_TIMEOUT_MS: u32 = 20;
+
+#[embassy_executor::task]
+async fn watchdog_task() {
+    let mut last = heartbeat::alive_count();
+    loop {
+        embassy_time::Timer::after_millis(u64::from(WATCHDOG_TIMEOUT_MS / 4)).await;
+        let now = heartbeat::alive_count();
+        if now != last {
+            watchdog::feed();
+            last = now;
+        }
+    }
 }
 
 #[embassy_executor::task]
@@ -81,6 +104,13 @@ fn main() -> ! {
         exit::exit(exit::FAULT);
     };
     time_driver::init(core.SYST);
+    if watchdog::take_reset_mark() {
+        defmt::error!("the previous run ended in a watchdog reset");
+        exit::exit(exit::WATCHDOG_RESET);
+    }
+    if !cfg!(feature = "hang") {
+        watchdog::start(WATCHDOG_TIMEOUT_MS);
+    }
     defmt::info!(
         "sonolube {} on {}, core clock {=u64} Hz",
         env!("CARGO_PKG_VERSION"),
@@ -91,10 +121,11 @@ fn main() -> ! {
     static EXECUTOR: StaticCell<raw::Executor> = StaticCell::new();
     let executor = EXECUTOR.init(raw::Executor::new(core::ptr::null_mut()));
     executor::run(executor, |spawner| {
-        match (heartbeat_task(), supervisor_task()) {
-            (Ok(heartbeat), Ok(supervisor)) => {
+        match (heartbeat_task(), supervisor_task(), watchdog_task()) {
+            (Ok(heartbeat), Ok(supervisor), Ok(watchdog)) => {
                 spawner.spawn(heartbeat);
                 spawner.spawn(supervisor);
+                spawner.spawn(watchdog);
             }
             _ => {
                 defmt::error!("could not spawn the tasks");
