@@ -6,6 +6,9 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod drive;
+pub mod ext_adc;
 pub mod fx;
 pub mod protocol;
 pub mod selfcheck;
+pub mod sense;

@@ -1,1 +1,84 @@
 //! Fixed-point arithmetic: formats and elementary functions used by the model's hot path.
+//!
+//! # Formats
+//!
+//! [`Q<FRAC>`](Q) is an `i32` with `FRAC` fractional bits (value = bits * 2^-FRAC); the format
+//! is part of the type, so a Q16.16 cannot be added to a Q2.30 by mistake.
+//!
+//! | alias       | range              | resolution | use                                      |
+//! |-------------|--------------------|------------|------------------------------------------|
+//! | [`Q16_16`]  | [-32768, 32768)    | 1.5e-5     | general values (speeds, loads, um)       |
+//! | [`Q8_24`]   | [-128, 128)        | 6.0e-8     | moderate values needing precision        |
+//! | [`Q6_26`]   | [-32, 32)          | 1.5e-8     | logarithms of wide-range quantities      |
+//! | [`Q5_27`]   | [-16, 16)          | 7.5e-9     | logarithms                               |
+//! | [`Q3_29`]   | [-4, 4)            | 1.9e-9     | angles up to pi                          |
+//! | [`Q2_30`]   | [-2, 2)            | 9.3e-10    | ratios with an exact 1.0, radians <= pi/2 |
+//! | [`Q1_31`]   | [-1, 1)            | 4.7e-10    | states and sines (+1.0 not representable) |
+//!
+//! # Never panic, never wrap
+//!
+//! There are no operator impls. Every operation is either checked (`Result<_, FxError>`, the
+//! `checked_*` methods and all elementary functions) or saturating with a flag (a [`Sat`] with
+//! `value` and `saturated`, the `saturating_*` methods). Nothing panics, at run time, with
+//! overflow checks on; the only panicking functions are the `*_const` constructors, meant for
+//! `const` items where a panic is a compile error.
+//!
+//! # Rounding
+//!
+//! Products, right shifts and format conversions round to nearest (add half an ulp, shift
+//! arithmetically: ties toward +infinity); quotients and float/ratio conversions round to nearest
+//! with ties away from zero. There is no truncation bias (tested over 1e4 accumulated products).
+//!
+//! # Elementary functions
+//!
+//! Errors are maximum absolute errors against f64, asserted by the tests (dense sweeps and, for
+//! 32-bit domains, checked exhaustively while developing). Costs are instructions per call,
+//! measured on the Cortex-M4 instruction set (QEMU `mps2-an386`, one instruction per translation
+//! block, `opt-level = "s"`, fat LTO) including about 4-15 instructions of call and `Result`
+//! overhead; SMULL/SMMLAR are single-cycle on the Cortex-M4F, so cycles are close to these counts.
+//!
+//! | function                      | input -> output           | max error            | cost   |
+//! |-------------------------------|---------------------------|----------------------|--------|
+//! | [`Q::sqrt`], [`Q::sqrt_to`]   | `Q<F>` >= 0 -> `Q<OUT>`   | 0.5 ulp (exact)      | ~95    |
+//! | [`isqrt_u64`]                 | `u64` -> `u32`            | exact floor          | ~75    |
+//! | [`Q::exp_neg`]                | `Q<F>` >= 0 -> Q2.30      | 0.75 ulp (7e-10)     | ~45    |
+//! | [`Q::exp`]                    | `Q<F>` -> `Q<OUT>`        | 1 ulp or 1.5e-9 rel. | ~55    |
+//! | [`Q::ln`], [`ln_scaled`]      | > 0 -> `Q<OUT>`           | 0.5 ulp + 8e-10      | ~55    |
+//! | [`Q2_30::asin`](Q::asin)      | Q2.30 in [-1, 1] -> Q2.30 | 1 ulp, 1e-6 rel.     | 65/115 |
+//! | [`sin`], [`cos`], [`sin_cos`] | `u32` turn -> Q1.31       | 1e-9                 | 35/40  |
+//! | `checked_mul(_to)`, `lerp`    |                           | 0.5 ulp              | 10-20  |
+//! | `checked_div(_to)`            |                           | 0.5 ulp              | ~200   |
+//!
+//! (asin: |z| <= 1/2 / |z| > 1/2, which needs a square root; sin / sin_cos.)
+//!
+//! # For the model code
+//!
+//! - Littmann law (physics-notes §1): `zeta: Q2_30 = v_s.checked_div_to(v_a)?` (precompute
+//!   `1/v_a` when it changes to avoid the division), handle |zeta| >= 1 first, then
+//!   `zeta.asin()?.checked_mul(Q2_30::FRAC_2_PI)?`.
+//! - Dahl update (§2): carry `f` in Q2.30 (exact +-1), `decay = kappa_dx.exp_neg()?` with
+//!   `kappa |dx|` in the finest format that holds it (Q2.30 below 2, Q8.24 below 128), then
+//!   `f = s.lerp(f, decay)?`, which stays in [-1, 1] by construction.
+//! - Rough contact (§3): `d = (R_q / lambda) (ln K_F - ln F_n)`; take `ln F_n` with
+//!   [`Q::ln`] or [`ln_scaled`] into Q6.26 and carry `ln K_F` precomputed, never `K_F`.
+//! - Cube model (§4): phases as `u32` turn fractions (`k * 2^31 / n` for a half period),
+//!   [`sin_cos`] per point, weights `exp_neg` of `2 lambda v / R_q` in Q16.16 or Q8.24.
+
+mod asin;
+mod convert;
+mod ctmath;
+mod div;
+mod error;
+mod exp;
+mod ln;
+mod ops;
+mod q;
+mod raw;
+mod sqrt;
+mod trig;
+
+pub use error::{FxError, Sat};
+pub use ln::ln_scaled;
+pub use q::{Q, Q1_31, Q2_30, Q3_29, Q5_27, Q6_26, Q8_24, Q16_16};
+pub use sqrt::isqrt_u64;
+pub use trig::{cos, sin, sin_cos};

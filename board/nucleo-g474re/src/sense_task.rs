@@ -1,0 +1,242 @@
+//! The drive-and-sense task: after the self-check, configure the drive (outputs off), arm the
+//! overcurrent trip, tare the current sense, then sample the sensors and log them at 2 Hz.
+
+use embassy_stm32::Peri;
+use embassy_stm32::peripherals::{ADC1, COMP1, DAC3, DMA1_CH1, PA0, PA1, PA8, PB0, PB13, TIM1};
+use embassy_time::{Duration, Instant};
+use sonolube::drive::{Amplitude, DriveLimits, DriveTiming, OvercurrentTrip};
+use sonolube::sense::{Calibration, SampleError, SensorChannel};
+
+use crate::overcurrent::OvercurrentGuard;
+use crate::sensing::{self, Block, CHANNELS, ChannelLog, TRIPLETS_PER_READ};
+use crate::{SELF_CHECK_PASSED, SENSING_STARTED, config, drive, safe};
+
+/// Everything the task owns.
+pub struct Hardware {
+    /// The drive timer.
+    pub tim1: Peri<'static, TIM1>,
+    /// TIM1_CH1: high-side gate-driver input.
+    pub high_side: Peri<'static, PA8>,
+    /// TIM1_CH1N: low-side gate-driver input.
+    pub low_side: Peri<'static, PB13>,
+    /// Overcurrent comparator.
+    pub comparator: Peri<'static, COMP1>,
+    /// Its threshold DAC.
+    pub threshold_dac: Peri<'static, DAC3>,
+    /// The sensing ADC.
+    pub adc: Peri<'static, ADC1>,
+    /// Normal-force amplifier output.
+    pub normal_force: Peri<'static, PA0>,
+    /// Tangential-force (friction) amplifier output.
+    pub tangential_force: Peri<'static, PB0>,
+    /// Current-sense amplifier output (also the comparator input).
+    pub drive_current: Peri<'static, PA1>,
+    /// The ADC's DMA channel.
+    pub dma: Peri<'static, DMA1_CH1>,
+    /// USER button B1, hold-to-run in the bring-up build.
+    #[cfg(feature = "bringup")]
+    pub button: Peri<'static, embassy_stm32::peripherals::PC13>,
+}
+
+/// Interval between sensor log lines.
+const LOG_PERIOD: Duration = Duration::from_millis(500);
+
+/// The task body. Never returns; on a configuration error it logs and parks with the outputs
+/// off.
+pub async fn run(mut hw: Hardware) {
+    SELF_CHECK_PASSED.wait().await;
+    let timing = config::TIMING;
+    let _drive = drive::Drive::new(hw.tim1, hw.high_side, hw.low_side, &timing);
+    log_timing(&timing);
+
+    let Ok(nominal_current) = config::CURRENT_SENSE.calibration() else {
+        defmt::error!("current-sense calibration out of range; drive stays off");
+        return;
+    };
+    let Ok(trip) = OvercurrentTrip::new(config::TRIP_CURRENT, &nominal_current) else {
+        defmt::error!("overcurrent trip out of the sensor range; drive stays off");
+        return;
+    };
+    let mut guard = OvercurrentGuard::arm(
+        hw.comparator,
+        hw.drive_current.reborrow(),
+        hw.threshold_dac,
+        trip,
+    );
+    log_trip(trip, &nominal_current);
+
+    let Ok(cell) = config::LOAD_CELL_INTERNAL.calibration() else {
+        defmt::error!("load-cell calibration out of range");
+        return;
+    };
+    let mut channels = [
+        SensorChannel::new(config::ADC_FORMAT, config::LOAD_CELL_LIMITS, cell),
+        SensorChannel::new(config::ADC_FORMAT, config::LOAD_CELL_LIMITS, cell),
+        SensorChannel::new(config::ADC_FORMAT, config::CURRENT_LIMITS, nominal_current),
+    ];
+    let mut ring = sensing::start(
+        hw.adc,
+        hw.normal_force,
+        hw.tangential_force,
+        hw.drive_current,
+        hw.dma,
+    );
+    defmt::info!(
+        "ADC1: PA0 normal, PB0 tangential, PA1 current; 16x oversampled on TIM1 TRGO2, \
+         {=u32} ns per conversion in a {=u32} ns quiet window",
+        config::ADC_CONVERSION_NS,
+        timing.quiet_window_ns()
+    );
+
+    // The first block, with the drive off, is the current sense's zero.
+    let mut block: Block = [0; CHANNELS * TRIPLETS_PER_READ];
+    if ring.read(&mut block).await.is_ok() {
+        tare_current(&mut channels[2], &block, &nominal_current, &mut guard);
+    }
+    // Ignore whatever faults the tare block would have shown: start the history afresh.
+    for channel in &mut channels {
+        channel.reset_faults();
+    }
+    drive::clear_break_flag();
+    SENSING_STARTED.signal(());
+
+    #[cfg(feature = "bringup")]
+    let mut hold = crate::bringup::HoldToRun::new(hw.button, timing);
+    let mut logs = [ChannelLog::new(), ChannelLog::new(), ChannelLog::new()];
+    let mut overruns: u32 = 0;
+    let mut next_log = Instant::now() + LOG_PERIOD;
+    loop {
+        match ring.read(&mut block).await {
+            Ok(_) => {
+                for triplet in block.chunks_exact(CHANNELS) {
+                    for (i, &code) in triplet.iter().enumerate() {
+                        let fault = logs[i].record(&mut channels[i], i32::from(code));
+                        // A saturated or disconnected current sense stops the drive at once;
+                        // load-cell faults are the control loop's business (logged here).
+                        if i == 2 && fault.is_some() {
+                            safe::drive_safe();
+                        }
+                    }
+                }
+            }
+            Err(_) => overruns = overruns.saturating_add(1),
+        }
+        #[cfg(feature = "bringup")]
+        hold.poll();
+        if Instant::now() >= next_log {
+            next_log += LOG_PERIOD;
+            log_sensors(&mut logs, &guard, overruns);
+        }
+    }
+}
+
+/// Tares the current channel from the current samples of `block` if their mean is near the
+/// nominal zero, and moves the trip threshold with it.
+fn tare_current(
+    current: &mut SensorChannel,
+    block: &Block,
+    nominal: &Calibration,
+    guard: &mut OvercurrentGuard,
+) {
+    let mut codes = [0i32; TRIPLETS_PER_READ];
+    for (code, triplet) in codes.iter_mut().zip(block.chunks_exact(CHANNELS)) {
+        *code = i32::from(triplet[2]);
+    }
+    let before = current.calibration();
+    if current.tare(&codes).is_err()
+        || !sensing::plausible_zero(current.calibration().offset(), nominal.offset())
+    {
+        defmt::warn!("current sense not at mid-scale with the drive off; nominal zero kept");
+        *current = SensorChannel::new(config::ADC_FORMAT, config::CURRENT_LIMITS, before);
+        return;
+    }
+    match OvercurrentTrip::new(config::TRIP_CURRENT, &current.calibration()) {
+        Ok(trip) => {
+            guard.set_trip(trip);
+            log_trip(trip, &current.calibration());
+        }
+        Err(_) => defmt::warn!("tared zero leaves no room for the trip; nominal trip kept"),
+    }
+}
+
+fn log_timing(timing: &DriveTiming) {
+    let clock = timing.clock();
+    let period = timing.period();
+    let dead_time = timing.dead_time();
+    defmt::info!(
+        "drive: {=u32} mHz achieved (ARR {=u32:#x}, step {=u32} mHz), dead time {=u32} ns \
+         ({=u32} ticks, DTG {=u8:#04x}), ADC trigger CCR4 {=u32:#x}; outputs OFF",
+        timing.frequency().millihertz(),
+        period.arr_register(),
+        period.frequency_step(clock),
+        dead_time.nanoseconds(clock),
+        dead_time.ticks(),
+        dead_time.dtg(),
+        timing.adc_trigger_compare()
+    );
+    let amplitude = config::BRINGUP_AMPLITUDE;
+    defmt::info!(
+        "drive: at amplitude {=u32}/1024, CH1 high {=u32} ns, CH1N high {=u32} ns per period; \
+         pulses vanish below amplitude {=u32}/1024",
+        amplitude.bits() >> 20,
+        timing.high_side_on_ns(amplitude),
+        timing.low_side_on_ns(amplitude),
+        timing.min_effective_amplitude().bits() >> 20
+    );
+    // The ratings' ceiling at this frequency (f64 once, at configuration).
+    match DriveLimits::new(&config::STACK, config::FULL_SCALE_V) {
+        Ok(limits) => defmt::info!(
+            "drive: amplitude ceiling {=u32}/1024 at this frequency (stack 15.466 V, 1.75 A; \
+             full scale {=u32} mV); at full scale CH1 high {=u32} ns",
+            limits.max_amplitude(timing.frequency()).bits() >> 20,
+            (config::FULL_SCALE_V * 1000.0) as u32,
+            timing.high_side_on_ns(Amplitude::FULL)
+        ),
+        Err(error) => defmt::error!("drive limits: {}", error),
+    }
+}
+
+fn log_trip(trip: OvercurrentTrip, calibration: &Calibration) {
+    defmt::info!(
+        "overcurrent: COMP1 (PA1) vs DAC3 code {=u16} -> TIM1 break at {=i32} mA",
+        trip.dac_code(),
+        sensing::milli(trip.trip_current(calibration))
+    );
+}
+
+fn log_sensors(logs: &mut [ChannelLog; 3], guard: &OvercurrentGuard, overruns: u32) {
+    let [normal, tangential, current] = [logs[0].take(), logs[1].take(), logs[2].take()];
+    defmt::info!(
+        "sense: normal {=i32} mN (code {=i32}), tangential {=i32} mN (code {=i32}), \
+         current {=i32} mA (code {=i32}); comparator {=bool}, break {=bool}, outputs {=bool}, \
+         overruns {=u32}",
+        normal.0,
+        normal.1,
+        tangential.0,
+        tangential.1,
+        current.0,
+        current.1,
+        guard.over_threshold(),
+        drive::break_tripped(),
+        drive::outputs_enabled(),
+        overruns
+    );
+    for (name, (_, _, faults, last)) in [
+        ("normal", normal),
+        ("tangential", tangential),
+        ("current", current),
+    ] {
+        if let Some(fault) = last {
+            log_fault(name, faults, fault);
+        }
+    }
+}
+
+fn log_fault(name: &str, faults: u32, fault: SampleError) {
+    defmt::warn!(
+        "sense: {=str} channel: {=u32} faulty samples, last {}",
+        name,
+        faults,
+        fault
+    );
+}
