@@ -5,4 +5,5 @@
 //! command-line tool's building blocks.
 
 pub mod papers;
+pub mod plot;
 pub mod reference;
