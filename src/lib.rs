@@ -6,9 +6,15 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod control;
 pub mod drive;
 pub mod ext_adc;
 pub mod fx;
+pub mod metrics;
+pub mod model;
+pub mod plant;
 pub mod protocol;
+pub mod resonance;
+pub mod scene;
 pub mod selfcheck;
 pub mod sense;

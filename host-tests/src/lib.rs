@@ -4,6 +4,9 @@
 //! model (written from the papers, never calling the fixed-point code), and the
 //! command-line tool's building blocks.
 
+pub mod cli;
+pub mod fixed_eval;
 pub mod papers;
 pub mod plot;
 pub mod reference;
+pub mod scene_file;

@@ -197,7 +197,44 @@ pub struct PaperCase {
     pub note: &'static str,
 }
 
+/// An evaluator with the signature of [`eval_named`] (the reference, or the fixed-point path).
+pub type Evaluator<'a> = &'a dyn Fn(
+    &str,
+    &BTreeMap<String, f64>,
+    &BTreeMap<String, String>,
+) -> Result<BTreeMap<&'static str, f64>, String>;
+
+impl Evaluation {
+    /// Runs `evaluator` on this evaluation and returns the output `self.output`.
+    pub fn run_with(&self, evaluator: Evaluator<'_>) -> Result<f64, String> {
+        let outputs = evaluator(self.model, &self.input_map(), &self.variant_map())?;
+        outputs
+            .get(self.output)
+            .copied()
+            .ok_or_else(|| format!("model `{}` has no output `{}`", self.model, self.output))
+    }
+}
+
 impl PaperCase {
+    /// The compared quantity computed with `evaluator` (for example the fixed-point models).
+    pub fn value_with(&self, evaluator: Evaluator<'_>) -> Result<f64, String> {
+        let value = self.evaluation.run_with(evaluator)?;
+        let inputs = self.evaluation.input_map();
+        let input = |key: &str| {
+            inputs
+                .get(key)
+                .copied()
+                .ok_or_else(|| format!("case {}: no input `{key}`", self.id))
+        };
+        Ok(match self.quantity {
+            Quantity::Output => value,
+            Quantity::MinusOther(other) => value - other.run_with(evaluator)?,
+            Quantity::OverOther(other) => value / other.run_with(evaluator)?,
+            Quantity::InputOverOutput(key) => input(key)? / value,
+            Quantity::OutputOverInput(key) => value / input(key)?,
+        })
+    }
+
     /// The compared quantity computed by the reference model.
     pub fn model_value(&self) -> Result<f64, RefError> {
         let value = self.evaluation.run()?;

@@ -1,6 +1,47 @@
-//! `sonolube`: the host command-line tool.
+//! `sonolube`: the host command-line tool (see `sonolube help`).
 
-fn main() {
-    eprintln!("usage: sonolube <command> ...");
-    std::process::exit(2);
+use std::process::ExitCode;
+
+/// Subcommand name, one-line description, entry point.
+type Subcommand = (&'static str, &'static str, fn(&[String]) -> ExitCode);
+
+const SUBCOMMANDS: &[Subcommand] = &[
+    // (subcommands register here)
+    (
+        "eval",
+        "evaluate a model in fixed point and f64 (JSON)",
+        sonolube_host::cli::eval::run,
+    ),
+    (
+        "papers",
+        "paper numbers vs reference vs fixed point (markdown)",
+        sonolube_host::cli::papers::run,
+    ),
+];
+
+fn usage() -> String {
+    let mut text = String::from("usage: sonolube <command> [arguments]\n\ncommands:\n");
+    for (name, about, _) in SUBCOMMANDS {
+        text.push_str(&format!("  {name:<10} {about}\n"));
+    }
+    text
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some(command) = args.first() else {
+        eprint!("{}", usage());
+        return ExitCode::from(2);
+    };
+    if command == "help" || command == "--help" || command == "-h" {
+        print!("{}", usage());
+        return ExitCode::SUCCESS;
+    }
+    match SUBCOMMANDS.iter().find(|(name, _, _)| name == command) {
+        Some((_, _, run)) => run(&args[1..]),
+        None => {
+            eprint!("sonolube: unknown command '{command}'\n\n{}", usage());
+            ExitCode::from(2)
+        }
+    }
 }

@@ -1,0 +1,380 @@
+//! The controller's settings in SI units, and the fixed-point configuration made from them.
+//!
+//! [`Settings`] is what a scene or a person writes (`f64`, SI); [`Config::new`] validates it
+//! and precomputes every coefficient once (filter poles, lead gain, reciprocal-free step
+//! sizes, the actuator's amplitude ceiling), so the control step only multiplies and adds.
+//! A `Config` is `Copy`: the loop swaps it atomically between steps
+//! (`Controller::reconfigure`).
+
+use super::estimate::{EstimatorConfig, NaturalConfig};
+use super::filter::{FilterError, LowPassCoef};
+use super::limits::{ActuatorRatings, AmplitudeLimit, LimitsError};
+use super::pi::{GainsError, PiGains};
+use super::schedule::GainSchedule;
+use super::shaper::{ShaperConfig, ShaperError};
+use super::sliding::SlidingConfig;
+use super::supervisor::RampConfig;
+use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
+
+/// Controller settings, SI units. [`Settings::REFERENCE`] is the acceptance scene's tuning.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Settings {
+    /// Control period, s (the loop runs at 1 / period; reference 100 us, 10 kHz).
+    pub period_s: f64,
+    /// -3 dB bandwidth of the normal-force filter, Hz.
+    pub normal_bandwidth_hz: f64,
+    /// -3 dB bandwidth of the tangential-force filter, Hz (also filters the prediction).
+    pub tangential_bandwidth_hz: f64,
+    /// -3 dB bandwidth of the sliding-velocity filter, Hz.
+    pub velocity_bandwidth_hz: f64,
+    /// Smallest normal force for which a friction coefficient is formed, N.
+    pub min_normal_force_n: f64,
+    /// Largest plausible |normal force|, N; beyond it the sensor is faulty.
+    pub normal_force_range_n: f64,
+    /// Largest plausible |tangential force|, N.
+    pub tangential_force_range_n: f64,
+    /// Largest plausible |sliding velocity|, m/s.
+    pub velocity_range_m_s: f64,
+    /// Speed above which the contact slides, m/s.
+    pub sliding_on_m_s: f64,
+    /// Speed below which it stops sliding, m/s (< `sliding_on_m_s`).
+    pub sliding_off_m_s: f64,
+    /// Time a sliding change must hold before it is accepted, s.
+    pub sliding_debounce_s: f64,
+    /// The scene's friction coefficient, the prior of the natural friction.
+    pub natural_prior: f64,
+    /// How many samples the prior is worth.
+    pub natural_prior_weight: u32,
+    /// Averaging window of the natural friction once learned, s.
+    pub natural_window_s: f64,
+    /// Estimated vibration amplitude below which the drive counts as off for learning,
+    /// fraction of full scale.
+    pub natural_max_drive: f64,
+    /// Time constant of the transducer's vibration envelope, s (reference 0.8 ms).
+    pub envelope_time_constant_s: f64,
+    /// Time constant the lead gives the envelope, s (<= the envelope's).
+    pub response_time_constant_s: f64,
+    /// Slew limit: time to change the command by full scale, s.
+    pub slew_full_scale_s: f64,
+    /// Soft start: time for the ceiling to rise by full scale, s.
+    pub ramp_up_full_scale_s: f64,
+    /// Ramp-down: time to fall from full scale to zero, s.
+    pub ramp_down_full_scale_s: f64,
+    /// Proportional gain of the correction PI right after a target change (ratio/ratio).
+    pub kp_fast: f64,
+    /// Integral gain of the correction PI right after a target change, 1/s.
+    pub ki_fast_per_s: f64,
+    /// Proportional gain of the correction PI in steady state (ratio per ratio).
+    pub kp: f64,
+    /// Integral gain of the correction PI in steady state, 1/s.
+    pub ki_per_s: f64,
+    /// Time constant of the fading from the fast to the steady gains, s.
+    pub boost_time_constant_s: f64,
+    /// Bound of the PI's integral, ratio units.
+    pub integral_limit: f64,
+    /// The actuator's ratings, for the amplitude ceiling.
+    pub actuator: ActuatorRatings,
+}
+
+impl Settings {
+    /// The tuning for the reference scene (10 kHz loop, 40 kHz drive, 0.8 ms envelope lag);
+    /// the rationale is in the `control` module docs. `natural_prior` should be set to the
+    /// scene's coefficient.
+    pub const REFERENCE: Self = Self {
+        period_s: 1e-4,
+        normal_bandwidth_hz: 200.0,
+        tangential_bandwidth_hz: 800.0,
+        velocity_bandwidth_hz: 200.0,
+        min_normal_force_n: 0.5,
+        normal_force_range_n: 2_000.0,
+        tangential_force_range_n: 2_000.0,
+        velocity_range_m_s: 5.0,
+        sliding_on_m_s: 1e-3,
+        sliding_off_m_s: 0.5e-3,
+        sliding_debounce_s: 2e-3,
+        natural_prior: 0.3,
+        natural_prior_weight: 4,
+        natural_window_s: 0.2,
+        natural_max_drive: 1e-3,
+        envelope_time_constant_s: 0.8e-3,
+        response_time_constant_s: 0.25e-3,
+        slew_full_scale_s: 0.5e-3,
+        ramp_up_full_scale_s: 5e-3,
+        ramp_down_full_scale_s: 5e-3,
+        kp_fast: 0.3,
+        ki_fast_per_s: 4_000.0,
+        kp: 0.0,
+        ki_per_s: 150.0,
+        boost_time_constant_s: 3e-3,
+        integral_limit: 0.5,
+        actuator: ActuatorRatings::SEED_003_40_KHZ,
+    };
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self::REFERENCE
+    }
+}
+
+/// Why settings were refused; `setting` names the field.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ConfigError {
+    /// A filter bandwidth or time constant is unusable.
+    Filter {
+        /// The field.
+        setting: &'static str,
+        /// Why.
+        error: FilterError,
+    },
+    /// The drive shaping settings are unusable.
+    Shaper(ShaperError),
+    /// The actuator ratings are unusable.
+    Limits(LimitsError),
+    /// The PI gains are unusable.
+    Gains(GainsError),
+    /// A value is NaN, non-positive where it must be positive, or does not fit its format.
+    OutOfRange {
+        /// The field.
+        setting: &'static str,
+    },
+}
+
+/// Plausible ranges of the sensor readings (beyond them a sensor is faulty).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SensorRanges {
+    /// Largest |F_n|, Q16.16 N.
+    pub normal: Q16_16,
+    /// Largest |F_t|, Q16.16 N.
+    pub tangential: Q16_16,
+    /// Largest |v|, Q8.24 m/s.
+    pub velocity: Q8_24,
+}
+
+/// The validated fixed-point configuration (`Copy`: swapped atomically between steps).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Config {
+    pub(super) period_s: f64,
+    pub(super) estimator: EstimatorConfig,
+    pub(super) ranges: SensorRanges,
+    pub(super) sliding: SlidingConfig,
+    pub(super) natural: NaturalConfig,
+    pub(super) natural_max_drive: Q1_31,
+    pub(super) shaper: ShaperConfig,
+    pub(super) ramp: RampConfig,
+    pub(super) gains: GainSchedule,
+    pub(super) limit: AmplitudeLimit,
+}
+
+/// A positive finite value, or the error naming `setting`.
+fn positive(value: f64, setting: &'static str) -> Result<f64, ConfigError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(ConfigError::OutOfRange { setting })
+    }
+}
+
+/// Steps of `duration_s`, rounded, at least one, saturating.
+fn steps(duration_s: f64, period_s: f64) -> u32 {
+    libm::round(duration_s / period_s).clamp(1.0, u32::MAX as f64) as u32
+}
+
+impl Config {
+    /// Validates `settings` and precomputes the fixed-point configuration (`f64`, once).
+    pub fn new(settings: &Settings) -> Result<Self, ConfigError> {
+        let s = settings;
+        let period = positive(s.period_s, "period_s")?;
+        let rate = 1.0 / period;
+        let filter = |hz: f64, setting| {
+            LowPassCoef::from_bandwidth(hz, rate)
+                .map_err(|error| ConfigError::Filter { setting, error })
+        };
+        let q16 = |x: f64, setting| {
+            Q16_16::from_f64(positive(x, setting)?).map_err(|_| ConfigError::OutOfRange { setting })
+        };
+        let q24 = |x: f64, setting| {
+            Q8_24::from_f64(positive(x, setting)?).map_err(|_| ConfigError::OutOfRange { setting })
+        };
+        let fraction = |x: f64, setting| {
+            if x.is_finite() && x >= 0.0 {
+                Ok(Q1_31::from_f64_saturating(x).value)
+            } else {
+                Err(ConfigError::OutOfRange { setting })
+            }
+        };
+        let step = |duration: f64, setting| {
+            let step = period / positive(duration, setting)?;
+            Ok::<_, ConfigError>(Q1_31::from_f64_saturating(step).value.max(Q1_31::ULP))
+        };
+        if !(s.sliding_off_m_s >= 0.0 && s.sliding_off_m_s < s.sliding_on_m_s) {
+            return Err(ConfigError::OutOfRange {
+                setting: "sliding_off_m_s",
+            });
+        }
+        let prior = positive(s.natural_prior, "natural_prior")?;
+        let prior = Q2_30::from_f64(prior).map_err(|_| ConfigError::OutOfRange {
+            setting: "natural_prior",
+        })?;
+        let prior_weight = s.natural_prior_weight.max(1);
+        let window =
+            steps(positive(s.natural_window_s, "natural_window_s")?, period).max(prior_weight);
+        let debounce = s.sliding_debounce_s;
+        if !(debounce.is_finite() && debounce >= 0.0) {
+            return Err(ConfigError::OutOfRange {
+                setting: "sliding_debounce_s",
+            });
+        }
+        Ok(Self {
+            period_s: period,
+            estimator: EstimatorConfig {
+                normal: filter(s.normal_bandwidth_hz, "normal_bandwidth_hz")?,
+                tangential: filter(s.tangential_bandwidth_hz, "tangential_bandwidth_hz")?,
+                velocity: filter(s.velocity_bandwidth_hz, "velocity_bandwidth_hz")?,
+                min_normal_force: q16(s.min_normal_force_n, "min_normal_force_n")?,
+            },
+            ranges: SensorRanges {
+                normal: q16(s.normal_force_range_n, "normal_force_range_n")?,
+                tangential: q16(s.tangential_force_range_n, "tangential_force_range_n")?,
+                velocity: q24(s.velocity_range_m_s, "velocity_range_m_s")?,
+            },
+            sliding: SlidingConfig {
+                on: q24(s.sliding_on_m_s, "sliding_on_m_s")?,
+                off: Q8_24::from_f64_saturating(s.sliding_off_m_s).value,
+                debounce_steps: libm::round(debounce / period).min(u32::MAX as f64) as u32,
+            },
+            natural: NaturalConfig {
+                prior,
+                prior_weight,
+                window,
+            },
+            natural_max_drive: fraction(s.natural_max_drive, "natural_max_drive")?,
+            shaper: ShaperConfig::new(
+                s.envelope_time_constant_s,
+                s.response_time_constant_s,
+                s.slew_full_scale_s,
+                period,
+            )
+            .map_err(ConfigError::Shaper)?,
+            ramp: RampConfig {
+                up_step: step(s.ramp_up_full_scale_s, "ramp_up_full_scale_s")?,
+                down_step: step(s.ramp_down_full_scale_s, "ramp_down_full_scale_s")?,
+            },
+            gains: GainSchedule::new(
+                PiGains::new(s.kp_fast, s.ki_fast_per_s, period, s.integral_limit)
+                    .map_err(ConfigError::Gains)?,
+                PiGains::new(s.kp, s.ki_per_s, period, s.integral_limit)
+                    .map_err(ConfigError::Gains)?,
+                s.boost_time_constant_s,
+                period,
+            )
+            .map_err(ConfigError::Gains)?,
+            limit: AmplitudeLimit::new(&s.actuator).map_err(ConfigError::Limits)?,
+        })
+    }
+
+    /// The control period, s.
+    pub const fn period_s(&self) -> f64 {
+        self.period_s
+    }
+
+    /// The PI gain schedule.
+    pub const fn gains(&self) -> GainSchedule {
+        self.gains
+    }
+
+    /// The actuator's amplitude ceiling.
+    pub const fn limit(&self) -> AmplitudeLimit {
+        self.limit
+    }
+
+    /// The estimator's filters and load guard.
+    pub const fn estimator(&self) -> EstimatorConfig {
+        self.estimator
+    }
+
+    /// The drive shaping (envelope model, lead gain, slew step).
+    pub const fn shaper(&self) -> ShaperConfig {
+        self.shaper
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reference_settings_make_a_config() {
+        let c = Config::new(&Settings::REFERENCE).unwrap();
+        assert_eq!(c.sliding.debounce_steps, 20);
+        assert_eq!(c.natural.window, 2_000);
+        assert!((c.ramp.up_step.to_f64() - 0.02).abs() < 1e-9);
+        assert!((c.shaper.slew_step().to_f64() - 0.2).abs() < 1e-9);
+        assert!((c.estimator.tangential.bandwidth_hz(10_000.0) - 800.0).abs() < 0.1);
+        assert_eq!(c.limit.max_amplitude, Q1_31::MAX);
+        assert!((c.gains.fast().ki_step().to_f64() - 0.4).abs() < 1e-9);
+        assert!((c.gains.slow().ki_step().to_f64() - 0.015).abs() < 1e-9);
+    }
+
+    #[test]
+    fn each_bad_setting_is_named() {
+        let r = Settings::REFERENCE;
+        let cases: [(Settings, ConfigError); 6] = [
+            (
+                Settings { period_s: 0.0, ..r },
+                ConfigError::OutOfRange {
+                    setting: "period_s",
+                },
+            ),
+            (
+                Settings {
+                    tangential_bandwidth_hz: 6_000.0,
+                    ..r
+                },
+                ConfigError::Filter {
+                    setting: "tangential_bandwidth_hz",
+                    error: FilterError::AboveNyquist,
+                },
+            ),
+            (
+                Settings {
+                    sliding_off_m_s: 2e-3,
+                    ..r
+                },
+                ConfigError::OutOfRange {
+                    setting: "sliding_off_m_s",
+                },
+            ),
+            (
+                Settings {
+                    natural_prior: 3.0,
+                    ..r
+                },
+                ConfigError::OutOfRange {
+                    setting: "natural_prior",
+                },
+            ),
+            (
+                Settings {
+                    ki_fast_per_s: 1e5,
+                    ..r
+                },
+                ConfigError::Gains(GainsError::OutOfRange),
+            ),
+            (
+                Settings {
+                    min_normal_force_n: f64::NAN,
+                    ..r
+                },
+                ConfigError::OutOfRange {
+                    setting: "min_normal_force_n",
+                },
+            ),
+        ];
+        for (settings, error) in cases {
+            assert_eq!(Config::new(&settings), Err(error));
+        }
+    }
+}

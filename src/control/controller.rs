@@ -1,0 +1,408 @@
+//! The friction controller: estimate, supervisor, feedforward, PI correction and drive
+//! shaping in one step (the design and its tuning are in the `control` module docs).
+
+use super::config::Config;
+use super::error::ControlError;
+use super::estimate::{FrictionEstimate, FrictionEstimator, NaturalFriction};
+use super::filter::LowPass;
+use super::io::{Inputs, Output, Saturation};
+use super::pi::{Clamp, Pi, PiGains};
+use super::reason::{ExternalFault, Reason, Sensor, SensorFault, SensorFaultKind};
+use super::recip::Reciprocal;
+use super::schedule::{Boost, GainSchedule};
+use super::shaper::DriveShaper;
+use super::sliding::SlidingDetector;
+use super::supervisor::{Contact, Supervisor};
+use super::target::PreparedTarget;
+use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
+use crate::model::{FrictionModel, ModelError, OperatingPoint, Reach};
+use crate::protocol::{SupervisorState, Target};
+
+/// The controller's state (separate from its [`Config`]; never re-allocated).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ControllerState {
+    supervisor: Supervisor,
+    estimator: FrictionEstimator,
+    estimate: FrictionEstimate,
+    sliding: SlidingDetector,
+    contact: Contact,
+    natural: NaturalFriction,
+    shaper: DriveShaper,
+    pi: Pi,
+    boost: Boost,
+    gains: PiGains,
+    prediction: LowPass<30>,
+    prediction_valid: bool,
+    target: Option<(Target, PreparedTarget)>,
+}
+
+/// The friction controller: configuration plus state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Controller {
+    config: Config,
+    state: ControllerState,
+}
+
+/// The loop's values of one step, for the output.
+#[derive(Default)]
+struct LoopReport {
+    target_ratio: Option<Q2_30>,
+    error: Q2_30,
+    feedforward: Q1_31,
+    reach: Option<Reach>,
+    saturation: Saturation,
+}
+
+impl Controller {
+    /// A controller in idle, no target, natural friction at the configured prior.
+    pub fn new(config: Config) -> Self {
+        Self {
+            state: ControllerState {
+                supervisor: Supervisor::new(),
+                estimator: FrictionEstimator::new(),
+                estimate: FrictionEstimate {
+                    normal_force: Q16_16::ZERO,
+                    tangential_force: Q16_16::ZERO,
+                    sliding_velocity: Q8_24::ZERO,
+                    coefficient: Q2_30::ZERO,
+                    load_ok: false,
+                    normal_reciprocal: Reciprocal::ONE,
+                },
+                sliding: SlidingDetector::new(),
+                contact: Contact::NotSliding,
+                natural: NaturalFriction::new(&config.natural),
+                shaper: DriveShaper::new(),
+                pi: Pi::new(),
+                boost: Boost::new(),
+                gains: config.gains.slow(),
+                prediction: LowPass::new(Q2_30::ONE),
+                prediction_valid: false,
+                target: None,
+            },
+            config,
+        }
+    }
+
+    /// Runs one control step on `inputs` with `model`. Never panics, whatever the inputs.
+    /// A sensor fault (reported or implausible) or a model error puts the drive at zero in
+    /// this very step.
+    pub fn step<M: FrictionModel + ?Sized>(&mut self, inputs: &Inputs, model: &M) -> Output {
+        let before = self.state.supervisor.state();
+        match inputs.sensor_fault.or_else(|| self.implausible(inputs)) {
+            Some(fault) => self.state.supervisor.latch(fault.into()),
+            None => self.estimate(inputs),
+        }
+        self.on_transition(before);
+        let mut report = LoopReport::default();
+        match self.state.supervisor.state() {
+            SupervisorState::RampUp | SupervisorState::Running => {
+                if self.close_loop(model, &mut report).is_err() {
+                    self.state.supervisor.latch(Reason::ModelError);
+                    self.state.shaper.apply(&self.config.shaper, Q1_31::ZERO);
+                    report = LoopReport::default();
+                }
+            }
+            SupervisorState::RampDown => {
+                let s = &mut self.state;
+                let lowered = s
+                    .shaper
+                    .command()
+                    .saturating_sub(self.config.ramp.down_step)
+                    .value;
+                // max/min rather than clamp: clamp has a panic path (min > max) in the binary.
+                let lowered = lowered
+                    .min(self.config.limit.max_amplitude)
+                    .max(Q1_31::ZERO);
+                s.shaper.apply(&self.config.shaper, lowered);
+                // A ramp-down lasts at least one step, so that its reason is seen.
+                if lowered == Q1_31::ZERO && before == SupervisorState::RampDown {
+                    s.supervisor.finish_ramp_down();
+                }
+            }
+            _ => self.state.shaper.apply(&self.config.shaper, Q1_31::ZERO),
+        }
+        self.output(report)
+    }
+
+    fn implausible(&self, inputs: &Inputs) -> Option<SensorFault> {
+        let r = &self.config.ranges;
+        let out = |sensor| {
+            Some(SensorFault {
+                sensor,
+                kind: SensorFaultKind::OutOfRange,
+            })
+        };
+        if inputs.normal_force.saturating_abs().value > r.normal {
+            out(Sensor::NormalForce)
+        } else if inputs.tangential_force.saturating_abs().value > r.tangential {
+            out(Sensor::TangentialForce)
+        } else if inputs.sliding_velocity.saturating_abs().value > r.velocity {
+            out(Sensor::SlidingVelocity)
+        } else {
+            None
+        }
+    }
+
+    fn estimate(&mut self, inputs: &Inputs) {
+        let (c, s) = (&self.config, &mut self.state);
+        s.estimate = s.estimator.update(
+            &c.estimator,
+            inputs.normal_force,
+            inputs.tangential_force,
+            inputs.sliding_velocity,
+        );
+        s.contact = match (
+            s.sliding.update(&c.sliding, inputs.sliding_velocity),
+            s.estimate.load_ok,
+        ) {
+            (false, _) => Contact::NotSliding,
+            (true, false) => Contact::NoLoad,
+            (true, true) => Contact::Ok,
+        };
+        // mu0 is the friction without vibration: learn it only while sliding, drive off.
+        let drive_off = s.shaper.envelope() <= c.natural_max_drive;
+        if s.contact == Contact::Ok && drive_off && s.supervisor.state() != SupervisorState::Fault {
+            s.natural.learn(&c.natural, s.estimate.coefficient);
+        }
+        s.supervisor.follow_contact(s.contact, s.shaper.command());
+    }
+
+    /// Closing the loop starts from rest: no correction, prediction re-seeded, fast gains.
+    fn on_transition(&mut self, before: SupervisorState) {
+        let now = self.state.supervisor.state();
+        if now == SupervisorState::RampUp && before != SupervisorState::RampUp {
+            self.state.pi.reset();
+            self.state.prediction_valid = false;
+            self.state.boost.restart();
+        }
+    }
+
+    fn close_loop<M: FrictionModel + ?Sized>(
+        &mut self,
+        model: &M,
+        report: &mut LoopReport,
+    ) -> Result<(), ModelError> {
+        let (c, s) = (&self.config, &mut self.state);
+        let Some((_, target)) = s.target else {
+            // start() refuses without a target and targets cannot be removed.
+            s.supervisor.stop();
+            return Ok(());
+        };
+        let estimate = s.estimate;
+        let natural = s.natural.reciprocal();
+        let target_ratio = target.ratio(natural, estimate.normal_reciprocal);
+        let measured = natural.times::<30, 30>(estimate.coefficient).value;
+        let ramping = s.supervisor.state() == SupervisorState::RampUp;
+        let max = c.limit.max_amplitude;
+        let ceiling = if ramping {
+            s.supervisor.ramp_ceiling().min(max)
+        } else {
+            max
+        };
+        report.target_ratio = Some(target_ratio.value);
+        report.saturation.target = target_ratio.saturated;
+        let desired = if target_ratio.value >= Q2_30::ONE {
+            // At or above natural friction the nearest reachable point is no vibration; the
+            // PI holds (nothing to correct) and the prediction is re-seeded on the way back.
+            s.prediction_valid = false;
+            report.error = target_ratio.value.saturating_sub(measured).value;
+            report.reach = Some(Reach::AboveNatural);
+            report.saturation.integral_frozen = true;
+            Q1_31::ZERO
+        } else {
+            let point = OperatingPoint {
+                normal_force: estimate.normal_force.max(c.estimator.min_normal_force),
+                sliding_velocity: estimate.sliding_velocity.saturating_abs().value,
+            };
+            // The reference: what the model says the cells should read now, given the drive
+            // actually applied (envelope estimate) and the same filter as the measurement.
+            // Without vibration F'/F is 1 by definition: no model call while the drive is off.
+            let envelope = s.shaper.envelope();
+            let predicted_now = if envelope == Q1_31::ZERO {
+                Q2_30::ONE
+            } else {
+                model.ratio(&point, envelope)?
+            };
+            if !s.prediction_valid {
+                let seed = measured.saturating_add(s.pi.correction()).value;
+                s.prediction.reset(seed);
+                s.prediction_valid = true;
+            }
+            let predicted = s.prediction.update(&c.estimator.tangential, predicted_now);
+            let reference = predicted.saturating_sub(s.pi.correction()).value;
+            let error = reference.saturating_sub(measured).value;
+            // This step's gains on the schedule; the change from the last step is bumpless.
+            let gains = c.gains.gains(s.boost.weight());
+            s.pi.retune(&s.gains, &gains);
+            s.gains = gains;
+            s.boost.advance(&c.gains);
+            let candidate = s.pi.candidate(&gains, error);
+            let command = target_ratio
+                .value
+                .saturating_add(candidate.correction())
+                .value;
+            let inversion = model.invert(&point, command.max(Q2_30::ZERO))?;
+            let actuator = inversion.amplitude > max;
+            let desired = inversion.amplitude.min(max);
+            let clamp = match inversion.reach {
+                Reach::AboveNatural => Clamp::Upper,
+                Reach::BelowMinimum => Clamp::Lower,
+                Reach::Reached if actuator || desired >= ceiling => Clamp::Lower,
+                Reach::Reached => Clamp::Free,
+            };
+            s.pi.commit(&gains, candidate, clamp);
+            report.error = error;
+            report.feedforward = inversion.amplitude;
+            report.reach = Some(if actuator {
+                Reach::BelowMinimum
+            } else {
+                inversion.reach
+            });
+            report.saturation.model = inversion.reach != Reach::Reached;
+            report.saturation.actuator = actuator;
+            report.saturation.integral_frozen = s.pi.frozen();
+            desired
+        };
+        let shaped = s.shaper.drive(&c.shaper, desired, ceiling);
+        report.saturation.slew = shaped.slew_limited;
+        report.saturation.soft_start = ramping && shaped.ceiling_limited;
+        s.supervisor
+            .advance_ramp_up(&c.ramp, shaped.ceiling_limited, max);
+        Ok(())
+    }
+
+    fn output(&self, report: LoopReport) -> Output {
+        let s = &self.state;
+        let natural = s.natural.reciprocal();
+        let target_ratio = report.target_ratio.or_else(|| {
+            s.target
+                .map(|(_, t)| t.ratio(natural, s.estimate.normal_reciprocal).value)
+        });
+        Output {
+            amplitude: s.shaper.command(),
+            state: s.supervisor.state(),
+            reason: s.supervisor.reason(),
+            fault: s.supervisor.fault(),
+            armed: s.supervisor.armed(),
+            sliding: s.sliding.is_sliding(),
+            estimate: s.estimate,
+            natural_coefficient: s.natural.coefficient(),
+            measured_ratio: natural.times::<30, 30>(s.estimate.coefficient).value,
+            target_ratio,
+            error: report.error,
+            correction: s.pi.correction(),
+            integral: s.pi.integral(),
+            feedforward: report.feedforward,
+            reach: report.reach,
+            saturation: report.saturation,
+        }
+    }
+
+    /// `start`: arms the run; the soft start begins now if the contact slides under load,
+    /// otherwise as soon as it does. Errors: fault latched (22), no target (23), already
+    /// ramping up or running (21).
+    pub fn start(&mut self) -> Result<(), ControlError> {
+        let before = self.state.supervisor.state();
+        let s = &mut self.state;
+        s.supervisor
+            .start(s.target.is_some(), s.contact, s.shaper.command())?;
+        self.on_transition(before);
+        Ok(())
+    }
+
+    /// `stop`: disarms and ramps the drive down. Always accepted.
+    pub fn stop(&mut self) -> Result<(), ControlError> {
+        self.state.supervisor.stop();
+        Ok(())
+    }
+
+    /// `target`: holds `target` from the next step on. Bumpless: the PI's reference does not
+    /// depend on the target, only the feedforward moves, at the slew limit; the PI's gains
+    /// restart from the fast set (a new operating point's model error is to be found).
+    /// Accepted in every state; error `InvalidTarget` (6) outside the command's range.
+    pub fn set_target(&mut self, target: Target) -> Result<(), ControlError> {
+        let prepared =
+            PreparedTarget::new(&target).ok_or(ControlError::InvalidTarget { target })?;
+        if self.state.target.map(|(t, _)| t) != Some(target) {
+            self.state.boost.restart();
+        }
+        self.state.target = Some((target, prepared));
+        Ok(())
+    }
+
+    /// `clear`: leaves a latched fault to idle. Error `WrongState` (21) without a fault. A
+    /// fault whose cause persists latches again at the next step.
+    pub fn clear_fault(&mut self) -> Result<(), ControlError> {
+        self.state.supervisor.clear()
+    }
+
+    /// New PI gains, bumpless (the correction does not jump). Accepted in every state.
+    pub fn set_gains(&mut self, gains: GainSchedule) -> Result<(), ControlError> {
+        self.config.gains = gains;
+        self.retune();
+        Ok(())
+    }
+
+    /// Moves the PI to the schedule's present gains without a jump.
+    fn retune(&mut self) {
+        let s = &mut self.state;
+        let gains = self.config.gains.gains(s.boost.weight());
+        s.pi.retune(&s.gains, &gains);
+        s.gains = gains;
+    }
+
+    /// Latches an external fault (overcurrent, overrun); the next step outputs zero.
+    pub fn trip(&mut self, fault: ExternalFault) {
+        self.state.supervisor.latch(fault.into());
+    }
+
+    /// Swaps the configuration between two steps, bumplessly: filter states, envelope
+    /// estimate and supervisor state are kept, the PI is retuned without a jump, and the
+    /// learned natural friction is kept unless the scene's prior changed (a new scene is
+    /// learned afresh). A lower actuator ceiling applies at the next step.
+    pub fn reconfigure(&mut self, config: Config) {
+        if config.natural.prior != self.config.natural.prior {
+            self.state.natural = NaturalFriction::new(&config.natural);
+        }
+        self.config = config;
+        self.retune();
+    }
+
+    /// The configuration in use.
+    pub const fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// The supervisor state.
+    pub const fn state(&self) -> SupervisorState {
+        self.state.supervisor.state()
+    }
+
+    /// The reason of the last transition.
+    pub const fn reason(&self) -> Reason {
+        self.state.supervisor.reason()
+    }
+
+    /// The latched fault, if any.
+    pub const fn fault(&self) -> Option<Reason> {
+        self.state.supervisor.fault()
+    }
+
+    /// The target as set (protocol form), if any.
+    pub fn target(&self) -> Option<Target> {
+        self.state.target.map(|(t, _)| t)
+    }
+
+    /// The natural friction coefficient `mu0`, Q2.30.
+    pub const fn natural_coefficient(&self) -> Q2_30 {
+        self.state.natural.coefficient()
+    }
+
+    /// A friction `ratio` expressed as a target of the same kind as the present one (for
+    /// telemetry: what the loop holds, in the user's terms).
+    pub fn report_ratio(&self, ratio: Q2_30) -> Option<Target> {
+        let s = &self.state;
+        s.target
+            .map(|(_, t)| t.report(ratio, s.natural.coefficient(), s.estimate.normal_force))
+    }
+}

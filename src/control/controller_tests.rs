@@ -1,0 +1,359 @@
+//! Tests of the controller's commands, supervisor transitions, faults and bumpless changes.
+
+use super::config::{Config, Settings};
+use super::controller::Controller;
+use super::error::ControlError;
+use super::io::{Inputs, Output};
+use super::pi::PiGains;
+use super::reason::{ExternalFault, Reason, Sensor, SensorFault, SensorFaultKind};
+use super::schedule::GainSchedule;
+use super::testkit::{LittmannModel, Plant};
+use crate::fx::{Q1_31, Q2_30, Q16_16};
+use crate::model::{FrictionModel, ModelError, OperatingPoint, Reach};
+use crate::protocol::{SupervisorState as S, Target};
+
+const T: f64 = 1e-4;
+const HALF: Target = Target::Reduction {
+    reduction_mpct: 50_000,
+};
+
+fn setup() -> (Controller, LittmannModel, Plant) {
+    let ctl = Controller::new(Config::new(&Settings::REFERENCE).unwrap());
+    (
+        ctl,
+        LittmannModel::new(0.0754),
+        Plant::new(0.3, 0.0754 * 0.9, 0.8e-3, T, 3),
+    )
+}
+
+fn run<M: FrictionModel>(
+    ctl: &mut Controller,
+    model: &M,
+    plant: &mut Plant,
+    steps: usize,
+) -> Output {
+    let mut out = ctl.step(&plant.measure(), model);
+    plant.advance(out.amplitude);
+    for _ in 1..steps {
+        out = ctl.step(&plant.measure(), model);
+        plant.advance(out.amplitude);
+    }
+    out
+}
+
+/// Sliding and running at half friction, settled.
+fn running() -> (Controller, LittmannModel, Plant) {
+    let (mut ctl, model, mut plant) = setup();
+    ctl.set_target(HALF).unwrap();
+    run(&mut ctl, &model, &mut plant, 100);
+    ctl.start().unwrap();
+    let out = run(&mut ctl, &model, &mut plant, 300);
+    assert_eq!((out.state, out.reason), (S::Running, Reason::RampDone));
+    assert!(out.amplitude.to_f64() > 0.5);
+    (ctl, model, plant)
+}
+
+#[test]
+fn commands_are_refused_with_the_protocol_codes() {
+    let (mut ctl, model, mut plant) = setup();
+    run(&mut ctl, &model, &mut plant, 50);
+    assert_eq!(ctl.start(), Err(ControlError::NoTarget));
+    assert!(matches!(
+        ctl.clear_fault(),
+        Err(ControlError::WrongState {
+            command: "clear",
+            ..
+        })
+    ));
+    let bad = Target::Reduction {
+        reduction_mpct: 100_000,
+    };
+    assert_eq!(
+        ctl.set_target(bad),
+        Err(ControlError::InvalidTarget { target: bad })
+    );
+    assert_eq!(ctl.target(), None);
+    ctl.set_target(HALF).unwrap();
+    ctl.start().unwrap();
+    assert_eq!(
+        (ctl.state(), ctl.reason()),
+        (S::RampUp, Reason::StartCommand)
+    );
+    assert_eq!(ctl.start().map_err(|e| e.code().code()), Err(21));
+    ctl.trip(ExternalFault::Overcurrent);
+    assert_eq!(ctl.start().map_err(|e| e.code().code()), Err(22));
+    assert_eq!(ctl.report_ratio(Q2_30::from_f64(0.5).unwrap()), Some(HALF));
+}
+
+#[test]
+fn soft_start_rises_at_the_ramp_rate_then_runs() {
+    let (mut ctl, model, mut plant) = setup();
+    ctl.set_target(HALF).unwrap();
+    run(&mut ctl, &model, &mut plant, 100);
+    ctl.start().unwrap();
+    let mut previous = 0.0;
+    for k in 0..200 {
+        let out = run(&mut ctl, &model, &mut plant, 1);
+        if out.state == S::RampUp {
+            assert!(out.amplitude.to_f64() - previous <= 0.02 + 1e-9, "step {k}");
+            assert!(out.saturation.soft_start || k == 0);
+        }
+        previous = out.amplitude.to_f64();
+    }
+    assert_eq!((ctl.state(), ctl.reason()), (S::Running, Reason::RampDone));
+}
+
+#[test]
+fn sensor_fault_zeroes_the_drive_in_the_same_step_and_latches() {
+    let (mut ctl, model, mut plant) = running();
+    let fault = SensorFault {
+        sensor: Sensor::TangentialForce,
+        kind: SensorFaultKind::Stuck,
+    };
+    let out = ctl.step(
+        &Inputs {
+            sensor_fault: Some(fault),
+            ..plant.measure()
+        },
+        &model,
+    );
+    assert_eq!(out.amplitude, Q1_31::ZERO);
+    assert_eq!(
+        (out.state, out.reason, out.fault),
+        (
+            S::Fault,
+            Reason::SensorFault(fault),
+            Some(Reason::SensorFault(fault))
+        )
+    );
+    assert_eq!(out.reason.code(), 45);
+    // Latched: healthy samples do not clear it, nor does a start.
+    let out = run(&mut ctl, &model, &mut plant, 100);
+    assert_eq!((out.state, out.amplitude), (S::Fault, Q1_31::ZERO));
+    assert!(ctl.start().is_err());
+    ctl.clear_fault().unwrap();
+    assert_eq!((ctl.state(), ctl.reason()), (S::Idle, Reason::ClearCommand));
+    ctl.start().unwrap();
+    assert_eq!(run(&mut ctl, &model, &mut plant, 300).state, S::Running);
+}
+
+#[test]
+fn implausible_readings_and_model_errors_are_faults_too() {
+    let (mut ctl, model, mut plant) = running();
+    let garbage = Inputs {
+        normal_force: Q16_16::from_int(30_000).unwrap(),
+        ..plant.measure()
+    };
+    let out = ctl.step(&garbage, &model);
+    assert_eq!((out.amplitude, out.state), (Q1_31::ZERO, S::Fault));
+    assert_eq!(out.reason.name(), "normal-out-of-range");
+
+    struct Broken;
+    impl FrictionModel for Broken {
+        fn ratio(&self, _: &OperatingPoint, _: Q1_31) -> Result<Q2_30, ModelError> {
+            Err(ModelError::OutOfDomain {
+                input: "normal_force",
+                reason: "test",
+            })
+        }
+    }
+    let (mut ctl, _, mut plant) = running();
+    let out = run(&mut ctl, &Broken, &mut plant, 1);
+    assert_eq!(
+        (out.amplitude, out.state, out.reason),
+        (Q1_31::ZERO, S::Fault, Reason::ModelError)
+    );
+}
+
+#[test]
+fn external_trip_zeroes_the_drive_at_the_next_step() {
+    let (mut ctl, model, mut plant) = running();
+    ctl.trip(ExternalFault::Overrun);
+    let out = run(&mut ctl, &model, &mut plant, 1);
+    assert_eq!((out.amplitude, out.reason), (Q1_31::ZERO, Reason::Overrun));
+}
+
+#[test]
+fn stop_ramps_down_at_the_configured_rate() {
+    let (mut ctl, model, mut plant) = running();
+    let before = run(&mut ctl, &model, &mut plant, 1);
+    ctl.stop().unwrap();
+    assert_eq!(
+        (ctl.state(), ctl.reason()),
+        (S::RampDown, Reason::StopCommand)
+    );
+    let mut previous = before.amplitude.to_f64();
+    let mut steps = 0;
+    loop {
+        let out = run(&mut ctl, &model, &mut plant, 1);
+        assert!(
+            previous - out.amplitude.to_f64() <= 0.02 + 1e-9,
+            "faster than 5 ms full scale"
+        );
+        previous = out.amplitude.to_f64();
+        steps += 1;
+        if out.state == S::Idle {
+            assert_eq!(
+                (out.reason, out.armed, out.amplitude),
+                (Reason::RampDone, false, Q1_31::ZERO)
+            );
+            break;
+        }
+        assert_eq!(out.state, S::RampDown);
+    }
+    assert!((25..=60).contains(&steps), "{steps} steps");
+}
+
+#[test]
+fn losing_sliding_ramps_down_and_resumes_when_it_returns() {
+    let (mut ctl, model, mut plant) = running();
+    plant.sliding_velocity = 0.0;
+    let trace: Vec<Output> = (0..100)
+        .map(|_| run(&mut ctl, &model, &mut plant, 1))
+        .collect();
+    let down = trace.iter().position(|o| o.state == S::RampDown).unwrap();
+    assert_eq!(trace[down].reason, Reason::NotSliding);
+    assert!(down >= 19, "debounced: {down}");
+    let last = trace.last().unwrap();
+    assert_eq!(
+        (last.state, last.reason, last.armed, last.sliding),
+        (S::Idle, Reason::RampDone, true, false)
+    );
+    assert_eq!(last.amplitude, Q1_31::ZERO);
+    plant.sliding_velocity = -0.038; // the other way
+    let out = run(&mut ctl, &model, &mut plant, 20);
+    assert_eq!((out.state, out.reason), (S::RampUp, Reason::SlidingResumed));
+    assert_eq!(run(&mut ctl, &model, &mut plant, 300).state, S::Running);
+    // Lifting the load: no friction coefficient to control.
+    plant.normal_force = 0.1;
+    let trace: Vec<Output> = (0..100)
+        .map(|_| run(&mut ctl, &model, &mut plant, 1))
+        .collect();
+    assert!(
+        trace
+            .iter()
+            .any(|o| (o.state, o.reason) == (S::RampDown, Reason::NoLoad))
+    );
+    assert_eq!(trace.last().unwrap().state, S::Idle);
+}
+
+#[test]
+fn target_at_natural_friction_holds_zero_drive() {
+    let (mut ctl, model, mut plant) = running();
+    ctl.set_target(Target::Coef { coef_ppm: 400_000 }).unwrap(); // above mu = 0.3
+    let out = run(&mut ctl, &model, &mut plant, 100);
+    assert_eq!(
+        (out.reach, out.amplitude, out.state),
+        (Some(Reach::AboveNatural), Q1_31::ZERO, S::Running)
+    );
+    assert!(out.saturation.integral_frozen);
+}
+
+#[test]
+fn target_changes_are_bumpless_in_the_feedback_path() {
+    let (mut ctl, model, mut plant) = running();
+    let before = run(&mut ctl, &model, &mut plant, 1);
+    // The same ratio as a coefficient target: nothing moves.
+    let coef = (0.5 * ctl.natural_coefficient().to_f64() * 1e6).round() as u32;
+    ctl.set_target(Target::Coef { coef_ppm: coef }).unwrap();
+    let same = run(&mut ctl, &model, &mut plant, 1);
+    assert!((same.amplitude.to_f64() - before.amplitude.to_f64()).abs() < 2e-3);
+    assert!((same.correction.to_f64() - before.correction.to_f64()).abs() < 1e-3);
+    // A real change: the correction stays continuous, the drive moves at the slew limit.
+    ctl.set_target(Target::Reduction {
+        reduction_mpct: 30_000,
+    })
+    .unwrap();
+    let after = run(&mut ctl, &model, &mut plant, 1);
+    assert!((after.correction.to_f64() - same.correction.to_f64()).abs() < 2e-3);
+    let slew = Config::new(&Settings::REFERENCE)
+        .unwrap()
+        .shaper()
+        .slew_step()
+        .to_f64();
+    assert!((after.amplitude.to_f64() - same.amplitude.to_f64()).abs() <= slew + 1e-9);
+    assert!(
+        after.amplitude < same.amplitude,
+        "less reduction, less drive"
+    );
+}
+
+#[test]
+fn gain_changes_and_reconfiguration_are_bumpless() {
+    let (mut ctl, model, mut plant) = running();
+    // The plant gets 25 % weaker: mid-transient the PI error is large, and a switch that is
+    // not bumpless would jump by the kp change times the error.
+    plant.velocity_max = 0.0754 * 0.75;
+    ctl.set_target(Target::Reduction {
+        reduction_mpct: 40_000,
+    })
+    .unwrap();
+    let mut mid = run(&mut ctl, &model, &mut plant, 1);
+    for _ in 0..30 {
+        if mid.error.to_f64().abs() > 0.01 {
+            break;
+        }
+        mid = run(&mut ctl, &model, &mut plant, 1);
+    }
+    assert!(mid.error.to_f64().abs() > 0.01, "{mid:?}");
+    let gains = PiGains::new(2.0, 4_000.0, T, 0.5).unwrap();
+    let mut switched = ctl;
+    switched.set_gains(GainSchedule::constant(gains)).unwrap();
+    let inputs = plant.measure();
+    let kept = ctl.step(&inputs, &model);
+    let new = switched.step(&inputs, &model);
+    let kp_now = Config::new(&Settings::REFERENCE)
+        .unwrap()
+        .gains()
+        .fast()
+        .kp()
+        .to_f64()
+        * 0.8;
+    let naive_jump = (2.0 - kp_now) * mid.error.to_f64().abs();
+    let moved = (new.correction.to_f64() - kept.correction.to_f64()).abs();
+    assert!(
+        moved < 0.3 * naive_jump,
+        "moved {moved}, a non-bumpless switch {naive_jump}"
+    );
+    // A new configuration (other filters, ramps and gains) between two steps, settled: the
+    // filter states, the envelope estimate, mu0 and the supervisor carry over (a fresh
+    // controller would restart from idle at zero drive).
+    run(&mut ctl, &model, &mut plant, 300);
+    let mut other = ctl;
+    let settings = Settings {
+        tangential_bandwidth_hz: 300.0,
+        normal_bandwidth_hz: 50.0,
+        kp: 1.0,
+        ..Settings::REFERENCE
+    };
+    other.reconfigure(Config::new(&settings).unwrap());
+    let inputs = plant.measure();
+    let a = ctl.step(&inputs, &model);
+    let b = other.step(&inputs, &model);
+    assert_eq!((b.state, b.reason), (S::Running, Reason::RampDone));
+    assert!(a.amplitude.to_f64() > 0.5);
+    assert!(
+        (a.amplitude.to_f64() - b.amplitude.to_f64()).abs() < 2e-3,
+        "{a:?}\n{b:?}"
+    );
+    assert!((a.correction.to_f64() - b.correction.to_f64()).abs() < 2e-3);
+    assert_eq!(
+        b.natural_coefficient, a.natural_coefficient,
+        "same prior: mu0 kept"
+    );
+}
+
+#[test]
+fn force_target_uses_the_measured_load() {
+    let (mut ctl, model, mut plant) = setup();
+    ctl.set_target(Target::Force { force_mn: 7_200 }).unwrap(); // 0.6 of 0.3 * 40 N
+    run(&mut ctl, &model, &mut plant, 100);
+    ctl.start().unwrap();
+    let out = run(&mut ctl, &model, &mut plant, 400);
+    assert!(
+        (out.target_ratio.unwrap().to_f64() - 0.6).abs() < 1e-3,
+        "{out:?}"
+    );
+    assert!((plant.ratio() - 0.6).abs() < 0.006, "{}", plant.ratio());
+    assert_eq!(out.reach, Some(Reach::Reached));
+}

@@ -1,0 +1,158 @@
+//! Friction control: hold a target friction by the drive amplitude of the ultrasonic
+//! lubrication (physics-notes §1-6).
+//!
+//! One [`Controller::step`] per control period (10 kHz in the reference scene) turns the two
+//! load cells and the sliding velocity into a drive amplitude:
+//!
+//! ```text
+//!  F_n, F_t, v ──> estimate ──> mu, F_n, v ──┬──> target ratio r_t (target.rs)
+//!  (Q16.16, Q8.24)  (filters, guard)         │
+//!                                            │  measured ratio r_m = mu / mu0
+//!  model.ratio(point, a_env) ─> r̂ ─> same filter as F_t ─> r̂_f
+//!  PI error e = (r̂_f - c) - r_m ──> PI (fast→slow gains) ──> correction c
+//!  model.invert(point, r_t + c) ──> feedforward amplitude ──> actuator ceiling
+//!   ──> lead (envelope-lag compensation) ──> slew ──> ceiling ──> drive command u
+//!  supervisor: idle / ramp-up / running / ramp-down / fault, a reason on every transition
+//! ```
+//!
+//! # Formats, units and ranges
+//!
+//! | quantity | type | unit | range |
+//! |---|---|---|---|
+//! | normal and tangential force, force ranges, `F_n_min` | Q16.16 | N | ±32768, 15 µN steps |
+//! | sliding velocity, sliding thresholds | Q8.24 | m/s | ±128 |
+//! | friction coefficients `mu`, `mu0`, coef target | Q2.30 | 1 | [0, 2) |
+//! | friction ratio `F'/F` (target, measured, command), PI error, correction, integral | Q2.30 | 1 | [0, 2), signed ±2 |
+//! | amplitudes (command, feedforward, envelope estimate, ceilings, ramp and slew steps) | Q1.31 | fraction of full scale | [0, 1) |
+//! | force target | Q18.14 ([`ForceQ`]) | N | up to 131072 N |
+//! | filter coefficient `alpha` | Q1.31 | 1 | [2^-20, 1) |
+//! | filter state | `i64` | input lsb × 2^31 | |
+//! | `kp`, lead gain `g` | Q8.24 | 1 | [0, 128) |
+//! | `ki T`, gain-schedule decay | Q2.30 | 1 | [0, 1] |
+//! | reciprocals `1/F_n`, `1/mu0` | [`Reciprocal`]: Q2.30 mantissa and exponent | | any positive value |
+//!
+//! Everything per step is integer arithmetic, rounded to nearest, saturating where a range can
+//! be exceeded; there is no division (reciprocals by Newton-Raphson), no float and no loop.
+//! Configuration ([`Settings`] → [`Config`]) is `f64`, once.
+//!
+//! # Estimate (estimate.rs, sliding.rs)
+//!
+//! First-order low-passes (filter.rs, exactly -3 dB at the stated frequency):
+//! **tangential force 800 Hz** (`tau` 0.2 ms: the friction must be seen within a fraction of
+//! the 3 ms settling budget), **normal force 200 Hz** and **velocity 200 Hz** (slow signals whose
+//! noise enters the ratio one for one; the lag error of the normal force on the acceptance load
+//! ramp is `(tau_n - tau_t) dF_n/dt / F_n` = 0.6 ms × 5 /s = 0.3 %). `mu = |F_t| / F_n`, with
+//! `F_n` guarded at `F_n_min` (0.5 N): below it the contact counts as unloaded. `mu0` starts at
+//! the scene's `mu` and is learned (running mean, then a 0.2 s window) only while sliding with
+//! the drive off, e.g. before a start or while the target is natural friction. Sliding:
+//! hysteresis 1 / 0.5 mm/s and a 2 ms debounce.
+//!
+//! # Feedforward, reference and PI (pi.rs, schedule.rs)
+//!
+//! The feedforward is the model inversion: `a = invert(point, r_t + c)` at the measured
+//! (filtered) `F_n` and `|v|`. The PI corrects the model error `c` in ratio units, so its loop
+//! gain does not depend on the slope of the model (the Littmann law has a dead zone and an
+//! infinite slope at its edge, where an amplitude-domain PI would be useless or unstable).
+//!
+//! The PI does not compare the measurement with the target but with what the model predicts the
+//! cells read *now*: `r̂ = model.ratio(point, a_env)` at the estimated actual envelope, passed
+//! through the tangential filter, minus the present correction. At steady state that is the
+//! target (`r̂ = r_t + c`), so `e = r_t - r_m` there and the integral removes every static
+//! error; during a transient, the envelope lag, the filter lag, the slew limit, the soft start
+//! and the saturations are all inside the prediction, so the error is only the model mismatch
+//! and the integral does not wind up over the feedforward's own transient. A target change moves
+//! nothing in the feedback path (bumpless); gain changes re-base the integral (bumpless).
+//! Clamping anti-windup freezes the integral when the drive is at its floor or ceiling in the
+//! direction the error pushes (the model's natural friction or full drive, the actuator limit,
+//! the soft start), and the integral is bounded to ±0.5 regardless.
+//!
+//! Tuning by pole placement. For a static mismatch `d`, `e_k = -(d + c_(k-1))`, so the
+//! correction obeys `c_k = (1 - kp - kiT) c_(k-1) + kp c_(k-2)` + drive: poles
+//! `z^2 - (1 - kp - kiT) z - kp = 0`. **Fast gains `kp` 0.3, `ki` 4000 /s** (`kiT` 0.4): poles
+//! 0.72 and -0.42, a 0.3 ms time constant, the scale of the two lags the mismatch is seen
+//! through (response 0.25 ms, filter 0.2 ms); faster overcorrects, because the mismatch seen
+//! mid-transient belongs to another amplitude (with ±20 % mismatch `d` itself changes with `c`
+//! by a factor 0.8 to 1.25, the margin this leaves). **Slow gains `kp` 0, `ki` 150 /s**: pole
+//! 0.985, 6.7 ms, a noise bandwidth of about 24 Hz. The gains start fast when the loop closes or
+//! the target changes and fade to the slow set with **`tau_boost` = 3 ms** (the settling budget):
+//! the model error of a new operating point is found quickly, then averaged.
+//!
+//! # Drive shaping and limits (shaper.rs, limits.rs)
+//!
+//! The envelope lag (0.8 ms, pole 0.8825) is cancelled by a lead that places the response pole at
+//! **`tau_resp` = 0.25 ms** (0.6703, gain `g` = 2.8): a step of amplitude settles to 2 % in about
+//! 1 ms instead of 3.2 ms, and steps up to 1/g of full scale need no more than full drive. Then
+//! the slew limit (full scale in 0.5 ms) and the ceiling `min(V_max / V_fs, I_max / (2 pi f C
+//! V_fs))` from the actuator ratings. Soft start: full scale in 5 ms; ramp-down: 5 ms.
+//!
+//! # Supervisor (supervisor.rs, reason.rs)
+//!
+//! Idle, ramp-up, running, ramp-down and a latched fault, with a [`Reason`] (stable code and
+//! name, table in reason.rs) on every transition. A sensor fault (reported, or a reading beyond
+//! the sensor's range) or a model error puts the drive at zero in the same step. Losing sliding
+//! or load ramps down to zero and restarts when the contact returns. Commands return
+//! [`ControlError`], which maps to the protocol's codes 21-23 (and 6 for a bad target).
+//!
+//! # Numbers (the test plant, `cargo test -p sonolube --lib control::closed_loop -- --nocapture`)
+//!
+//! Littmann plant and model, 40 N, 0.038 m/s, 0.8 ms envelope lag, 10 kHz; plant amplitude
+//! scale and scene `mu` each off by ±20 % (all four corners); target step 100 % → 50 % of
+//! natural friction after 100 ms at natural friction:
+//! - no noise: settling to ±2 % in 1.1-2.9 ms (1.6 ms without mismatch), overshoot ≤ 3.6 % of
+//!   the step, residual error 0.13 % (the prior's share of the learned `mu0`);
+//! - 0.5 % full-scale noise (normal cell 300 N, tangential 25 N; 3 seeds): RMS error from 3 ms on
+//!   0.22-0.63 % of the target, overshoot ≤ 4.2 %;
+//! - load ramp 40 → 240 N in 1 s, coefficient target, model error drifting from -20 % to +20 %:
+//!   largest error 0.57 % without noise; with noise (tangential cell 100 N, so 8 % of the target
+//!   friction per sample at 40 N) mean -0.47 %, RMS 0.6 %, largest 1.9 % above 60 N but up to
+//!   3 % at 40-60 N, where the noise is that large.
+//!
+//! Cost on the Cortex-M4 (QEMU mps2-an386 with `-icount`, opt-level "s", fat LTO): about 1100
+//! instructions per running step for the controller alone (the step calls the model twice:
+//! `ratio` once for the prediction and `invert` once), 2760 with a closed-form Littmann model
+//! that divides three times; a model must therefore stay within about 1900 instructions for its
+//! `ratio` and `invert` together (a 16-step bisection inversion needs a cheap `ratio`).
+
+mod config;
+mod controller;
+mod error;
+mod estimate;
+mod filter;
+mod io;
+mod limits;
+mod pi;
+mod reason;
+mod recip;
+mod schedule;
+mod shaper;
+mod sliding;
+mod supervisor;
+mod target;
+
+#[cfg(test)]
+mod closed_loop;
+#[cfg(test)]
+mod controller_tests;
+#[cfg(test)]
+mod property_tests;
+#[cfg(test)]
+mod testkit;
+
+pub use config::{Config, ConfigError, SensorRanges, Settings};
+pub use controller::{Controller, ControllerState};
+pub use error::ControlError;
+pub use estimate::{
+    EstimatorConfig, FrictionEstimate, FrictionEstimator, MIN_NATURAL_COEF, NaturalConfig,
+    NaturalFriction,
+};
+pub use filter::{FilterError, LowPass, LowPassCoef};
+pub use io::{Inputs, Output, Saturation};
+pub use limits::{ActuatorRatings, AmplitudeLimit, Binding, LimitsError};
+pub use pi::{Clamp, GainsError, Pi, PiCandidate, PiGains};
+pub use reason::{ExternalFault, Reason, Sensor, SensorFault, SensorFaultKind};
+pub use recip::Reciprocal;
+pub use schedule::{Boost, GainSchedule};
+pub use shaper::{DriveShaper, Shaped, ShaperConfig, ShaperError};
+pub use sliding::{SlidingConfig, SlidingDetector};
+pub use supervisor::{Contact, RampConfig, Supervisor};
+pub use target::{ForceQ, PreparedTarget};

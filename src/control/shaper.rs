@@ -1,0 +1,238 @@
+//! From the desired vibration amplitude to the drive command: envelope-lag compensation, the
+//! slew limit and the ceilings.
+//!
+//! The transducer's vibration envelope follows the drive command with a first-order lag
+//! (acceptance scene: `tau_env = 0.8 ms`, eight control periods). A plain step of the command
+//! would take `4 tau_env = 3.2 ms` to come within 2 %, more than the whole settling budget.
+//! The shaper keeps an estimate `a_env` of the envelope (the same lag, `alpha_env = 1 -
+//! exp(-T / tau_env)`) and commands `u = a_env + g (a_desired - a_env)` with
+//! `g = alpha_resp / alpha_env`, which makes the envelope follow the desired amplitude with
+//! the faster time constant `tau_resp` (default 0.25 ms, `g = 2.8`): the lag's pole is
+//! cancelled and replaced (a first-order lead). The overdrive this needs is bounded by the
+//! slew limit and the ceilings; when they cut it, the estimate still follows the command
+//! actually applied, so it stays right and the response is simply slower.
+//!
+//! Order of the limits: lead, then slew (`|u - u_prev| <= slew_step`), then the ceiling and
+//! the floor 0. The ceiling comes last because it is a rating: it is never exceeded, even if
+//! that means a step larger than the slew limit.
+
+use super::filter::{FilterError, LowPass, LowPassCoef};
+use crate::fx::{Q1_31, Q8_24};
+
+/// Configuration of the drive shaping.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ShaperConfig {
+    envelope: LowPassCoef,
+    lead_gain: Q8_24,
+    slew_step: Q1_31,
+}
+
+/// Why the shaping settings were refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ShaperError {
+    /// A time constant or the period is not usable as a filter (see [`FilterError`]).
+    Filter(FilterError),
+    /// The slew time is not a finite positive number, or the lead gain is >= 128.
+    OutOfRange,
+}
+
+impl ShaperConfig {
+    /// Shaping for an envelope lag `envelope_tau_s`, a desired response time constant
+    /// `response_tau_s` (equal to `envelope_tau_s` for no lead), and a slew limit of full
+    /// scale in `slew_full_scale_s`, at the control period `period_s`. Configuration only.
+    pub fn new(
+        envelope_tau_s: f64,
+        response_tau_s: f64,
+        slew_full_scale_s: f64,
+        period_s: f64,
+    ) -> Result<Self, ShaperError> {
+        let envelope = LowPassCoef::from_time_constant(envelope_tau_s, period_s)
+            .map_err(ShaperError::Filter)?;
+        let response = LowPassCoef::from_time_constant(response_tau_s, period_s)
+            .map_err(ShaperError::Filter)?;
+        if !(slew_full_scale_s.is_finite() && slew_full_scale_s > 0.0) {
+            return Err(ShaperError::OutOfRange);
+        }
+        let gain = response.alpha().to_f64() / envelope.alpha().to_f64();
+        let lead_gain = Q8_24::from_f64(gain).map_err(|_| ShaperError::OutOfRange)?;
+        let step = (period_s / slew_full_scale_s).min(1.0);
+        let slew_step = Q1_31::from_f64_saturating(step).value.max(Q1_31::ULP);
+        Ok(Self {
+            envelope,
+            lead_gain,
+            slew_step,
+        })
+    }
+
+    /// The envelope model's coefficient `1 - exp(-T / tau_env)`.
+    pub const fn envelope(&self) -> LowPassCoef {
+        self.envelope
+    }
+
+    /// The lead gain `g`, Q8.24, >= 1 when the response is faster than the envelope.
+    pub const fn lead_gain(&self) -> Q8_24 {
+        self.lead_gain
+    }
+
+    /// Largest change of the command per step, Q1.31 fraction of full scale.
+    pub const fn slew_step(&self) -> Q1_31 {
+        self.slew_step
+    }
+}
+
+/// The command of one step and which limit shaped it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Shaped {
+    /// Drive command, Q1.31 fraction of full scale in [0, ceiling].
+    pub amplitude: Q1_31,
+    /// The slew limit cut the lead's command.
+    pub slew_limited: bool,
+    /// The ceiling cut the command.
+    pub ceiling_limited: bool,
+}
+
+/// State of the drive shaping: the last command and the envelope estimate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DriveShaper {
+    command: Q1_31,
+    envelope: LowPass<31>,
+}
+
+impl DriveShaper {
+    /// Drive off, envelope at rest.
+    pub const fn new() -> Self {
+        Self {
+            command: Q1_31::ZERO,
+            envelope: LowPass::new(Q1_31::ZERO),
+        }
+    }
+
+    /// Shapes the `desired` amplitude into this step's command under `ceiling` (both Q1.31
+    /// in [0, 1)) and advances the envelope estimate with it.
+    pub fn drive(&mut self, config: &ShaperConfig, desired: Q1_31, ceiling: Q1_31) -> Shaped {
+        let envelope = self.envelope.output().to_bits() as i64;
+        // (desired - envelope) in (-2^31, 2^31) times g < 2^31: below 2^62.
+        let push = (desired.to_bits() as i64 - envelope) * config.lead_gain.to_bits() as i64;
+        let lead = envelope + ((push + (1 << 23)) >> 24);
+        let previous = self.command.to_bits() as i64;
+        let step = config.slew_step.to_bits() as i64;
+        // max/min, not clamp: no panic path in the binary.
+        let slewed = lead.min(previous + step).max(previous - step);
+        let ceiling_bits = ceiling.to_bits().max(0) as i64;
+        let bounded = slewed.min(ceiling_bits).max(0);
+        let shaped = Shaped {
+            amplitude: Q1_31::from_bits(bounded as i32), // in [0, ceiling]
+            slew_limited: slewed != lead,
+            ceiling_limited: slewed > ceiling_bits,
+        };
+        self.apply(config, shaped.amplitude);
+        shaped
+    }
+
+    /// Applies `amplitude` as it is (ramp-down, drive off, fault: no lead, no slew) and
+    /// advances the envelope estimate with it. Negative values are taken as zero.
+    pub fn apply(&mut self, config: &ShaperConfig, amplitude: Q1_31) {
+        self.command = amplitude.max(Q1_31::ZERO);
+        self.envelope.update(&config.envelope, self.command);
+    }
+
+    /// The last command, Q1.31 fraction of full scale in [0, 1).
+    pub const fn command(&self) -> Q1_31 {
+        self.command
+    }
+
+    /// The estimated vibration envelope (the command through the transducer's lag), Q1.31
+    /// fraction of full scale in [0, 1). Exactly zero once the drive has been off long enough.
+    pub const fn envelope(&self) -> Q1_31 {
+        self.envelope.output()
+    }
+}
+
+impl Default for DriveShaper {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    const T: f64 = 1e-4;
+
+    fn a(x: f64) -> Q1_31 {
+        Q1_31::from_f64(x).unwrap()
+    }
+
+    #[test]
+    fn lead_makes_the_envelope_follow_the_faster_time_constant() {
+        // A slow slew limit would hide the lead; allow full scale in one step here.
+        let cfg = ShaperConfig::new(0.8e-3, 0.25e-3, 1e-4, T).unwrap();
+        assert!((cfg.lead_gain().to_f64() - 2.805).abs() < 1e-3);
+        let mut shaper = DriveShaper::new();
+        let mut true_envelope = 0.0f64;
+        let alpha_env = 1.0 - (-T / 0.8e-3f64).exp();
+        for n in 1..=30 {
+            let shaped = shaper.drive(&cfg, a(0.3), Q1_31::MAX);
+            true_envelope += alpha_env * (shaped.amplitude.to_f64() - true_envelope);
+            let want = 0.3 * (1.0 - (-(n as f64) * T / 0.25e-3).exp());
+            assert!(
+                (true_envelope - want).abs() < 1e-6,
+                "step {n}: {true_envelope} vs {want}"
+            );
+            assert!((shaper.envelope().to_f64() - true_envelope).abs() < 1e-8);
+        }
+    }
+
+    #[test]
+    fn slew_and_ceiling_limit_the_command() {
+        let cfg = ShaperConfig::new(0.8e-3, 0.25e-3, 0.5e-3, T).unwrap(); // 0.2 per step
+        let mut shaper = DriveShaper::new();
+        let s = shaper.drive(&cfg, a(0.9), a(0.5));
+        assert!(s.slew_limited && !s.ceiling_limited);
+        assert!((s.amplitude.to_f64() - 0.2).abs() < 1e-9);
+        let s = shaper.drive(&cfg, a(0.9), a(0.5));
+        assert!((s.amplitude.to_f64() - 0.4).abs() < 1e-9);
+        let s = shaper.drive(&cfg, a(0.9), a(0.5));
+        assert!(s.ceiling_limited && s.amplitude == a(0.5));
+        // A ceiling dropped below the command applies at once, beyond the slew limit.
+        let s = shaper.drive(&cfg, a(0.9), a(0.1));
+        assert_eq!(s.amplitude, a(0.1));
+        // Drive off: the envelope estimate decays to exactly zero.
+        for _ in 0..2_000 {
+            shaper.apply(&cfg, Q1_31::ZERO);
+        }
+        assert_eq!(shaper.envelope(), Q1_31::ZERO);
+    }
+
+    #[test]
+    fn settings_are_validated() {
+        assert!(ShaperConfig::new(0.0, 0.25e-3, 1e-3, T).is_err());
+        assert!(ShaperConfig::new(0.8e-3, 0.25e-3, 0.0, T).is_err());
+        assert_eq!(
+            ShaperConfig::new(10.0, 1e-6, 1e-3, T),
+            Err(ShaperError::OutOfRange)
+        );
+    }
+
+    proptest! {
+        #[test]
+        fn any_requests_stay_in_zero_to_ceiling(
+            steps in proptest::collection::vec((any::<i32>(), any::<i32>()), 1..100)
+        ) {
+            let cfg = ShaperConfig::new(0.8e-3, 0.1e-3, 0.2e-3, T).unwrap();
+            let mut shaper = DriveShaper::new();
+            for (desired, ceiling) in steps {
+                let s = shaper.drive(&cfg, Q1_31::from_bits(desired), Q1_31::from_bits(ceiling));
+                prop_assert!(!s.amplitude.is_negative());
+                prop_assert!(s.amplitude.to_bits() <= ceiling.max(0));
+                prop_assert!(!shaper.envelope().is_negative());
+            }
+        }
+    }
+}

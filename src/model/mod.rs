@@ -1,0 +1,177 @@
+//! The friction model in fixed point: the hot-path half of every model in the papers.
+//!
+//! Each model is split the same way (physics-notes §5):
+//! - a *constants* type built once per scene from SI inputs in `f64` (materials, surface, geometry,
+//!   actuator): every overflow- or underflow-prone quantity (E*, K_F, omega_c, K_t, ...) is folded
+//!   into dimensionless groups there, and its logarithm is carried instead where needed;
+//! - a *hot path* in fixed point (`crate::fx`), called per control step, whose inputs and outputs
+//!   state their Q format and range in the type or the doc comment.
+//!
+//! Inputs outside a model's validity give a [`ModelError`] or a documented, flagged saturation,
+//! never a panic, a wrap or a NaN.
+
+use core::fmt;
+
+pub mod actuator;
+pub mod contact;
+pub mod contact_constants;
+pub mod coulomb;
+pub mod coulomb_sampled;
+pub mod cube;
+pub mod cube_model;
+mod cube_nodes;
+pub mod dahl;
+pub(crate) mod dahl_cycle;
+pub(crate) mod dahl_quadrature;
+pub mod dahl_relax;
+pub mod dahl_steady;
+pub(crate) mod dahl_travel;
+pub mod dahl_window;
+pub mod exp_coulomb;
+pub mod horn;
+pub mod littmann;
+pub mod quadrature;
+pub mod scaled;
+pub mod wide;
+
+use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
+
+/// Why a model could not be evaluated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ModelError {
+    /// An SI input is NaN or infinite.
+    NonFinite {
+        /// Name of the input, as in the evaluation tool's key table.
+        input: &'static str,
+    },
+    /// An input is outside the model's domain of validity.
+    OutOfDomain {
+        /// Name of the input.
+        input: &'static str,
+        /// Which bound it breaks, in words.
+        reason: &'static str,
+    },
+    /// A value does not fit the fixed-point format that carries it.
+    Overflow {
+        /// Name of the quantity.
+        quantity: &'static str,
+    },
+}
+
+impl fmt::Display for ModelError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::NonFinite { input } => write!(f, "input {input} is not a finite number"),
+            Self::OutOfDomain { input, reason } => {
+                write!(f, "input {input} is out of domain: {reason}")
+            }
+            Self::Overflow { quantity } => {
+                write!(f, "{quantity} does not fit its fixed-point format")
+            }
+        }
+    }
+}
+
+impl core::error::Error for ModelError {}
+
+/// Operating point of the sliding contact, in the units the control step carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct OperatingPoint {
+    /// Normal load F_n in newtons, Q16.16: 0 < F_n < 32768 N, resolution 15 uN.
+    pub normal_force: Q16_16,
+    /// Sliding velocity in m/s, Q8.24: |v| < 128 m/s, resolution 6e-8 m/s.
+    pub sliding_velocity: Q8_24,
+}
+
+/// Whether a requested friction ratio can be reached by some vibration amplitude.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Reach {
+    /// The returned amplitude achieves the target (within the inversion's tolerance).
+    Reached,
+    /// The target is below the lowest friction the model gives at full amplitude: the returned
+    /// amplitude is the full amplitude, the nearest reachable point.
+    BelowMinimum,
+    /// The target is above the natural (no-vibration) friction: the returned amplitude is zero.
+    AboveNatural,
+}
+
+/// Result of inverting a model: the vibration amplitude for a target friction ratio.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Inversion {
+    /// Vibration amplitude as a fraction of the scene's full-scale amplitude, Q1.31 in [0, 1).
+    pub amplitude: Q1_31,
+    /// Friction ratio F'/F that the model gives at `amplitude`, Q2.30 in [0, 1].
+    pub ratio: Q2_30,
+    /// Whether the target was reachable.
+    pub reach: Reach,
+}
+
+/// A friction model the controller can evaluate and invert at an operating point.
+///
+/// The model's amplitude is dimensionless: a fraction of the scene's full-scale vibration
+/// amplitude (how a drive voltage becomes a vibration amplitude is the actuator's business).
+/// Physics makes every model here monotone non-increasing in amplitude, which [`invert`] relies
+/// on.
+pub trait FrictionModel {
+    /// Friction ratio F'/F (with vibration over without), Q2.30 in [0, 1], at `amplitude`
+    /// (Q1.31 fraction of full scale, in [0, 1)).
+    fn ratio(&self, point: &OperatingPoint, amplitude: Q1_31) -> Result<Q2_30, ModelError>;
+
+    /// The amplitude that gives `target` (Q2.30, F'/F). The default bisects [`Self::ratio`];
+    /// models with a closed-form inverse override it.
+    fn invert(&self, point: &OperatingPoint, target: Q2_30) -> Result<Inversion, ModelError> {
+        invert(self, point, target, BISECTION_STEPS)
+    }
+}
+
+/// Bisection steps of the default inversion: 2^-16 of full scale, finer than the drive's
+/// amplitude resolution.
+pub const BISECTION_STEPS: u32 = 16;
+
+/// Inverts a monotone non-increasing model by bisection over the amplitude, with `steps`
+/// halvings (the amplitude is then within 2^-steps of full scale of the exact inverse).
+pub fn invert<M: FrictionModel + ?Sized>(
+    model: &M,
+    point: &OperatingPoint,
+    target: Q2_30,
+    steps: u32,
+) -> Result<Inversion, ModelError> {
+    let natural = model.ratio(point, Q1_31::ZERO)?;
+    if target >= natural {
+        return Ok(Inversion {
+            amplitude: Q1_31::ZERO,
+            ratio: natural,
+            reach: Reach::AboveNatural,
+        });
+    }
+    let full = model.ratio(point, Q1_31::MAX)?;
+    if target <= full {
+        return Ok(Inversion {
+            amplitude: Q1_31::MAX,
+            ratio: full,
+            reach: Reach::BelowMinimum,
+        });
+    }
+    // Invariant: ratio(low) > target > ratio(high).
+    let (mut low, mut high) = (0i32, Q1_31::MAX.to_bits());
+    let mut ratio_high = full;
+    for _ in 0..steps.min(31) {
+        let mid = low + (high - low) / 2;
+        let ratio = model.ratio(point, Q1_31::from_bits(mid))?;
+        if ratio > target {
+            low = mid;
+        } else {
+            high = mid;
+            ratio_high = ratio;
+        }
+    }
+    Ok(Inversion {
+        amplitude: Q1_31::from_bits(high),
+        ratio: ratio_high,
+        reach: Reach::Reached,
+    })
+}

@@ -1,0 +1,225 @@
+//! A scene's model spec turned into a concrete friction model.
+//!
+//! [`AnyModel`] holds one of the concrete models of [`crate::model`], built from a
+//! [`ModelSpec`] and the scene's hardware (full-scale amplitude, frequency, horn), and
+//! dispatches [`FrictionModel`] to it. The plant builds one from the scene's plant spec; a
+//! controller can build one from the controller spec the same way.
+
+use crate::fx::{Q1_31, Q2_30};
+use crate::model::contact::{ContactKind, ContactParams, EStarRule};
+use crate::model::coulomb::{CoulombConstants, CoulombModel};
+use crate::model::cube::{CubeOptions, CubeParams};
+use crate::model::cube_model::CubeModel;
+use crate::model::dahl::DahlParams;
+use crate::model::dahl_steady::DahlModel;
+use crate::model::horn::UPhase;
+use crate::model::quadrature::SlipWindow;
+use crate::model::{FrictionModel, Inversion, ModelError, OperatingPoint};
+use crate::plant::exp_average::ExpCoulombVibrated;
+use crate::scene::{ModelKind, ModelSpec, RoughSurface, Scene};
+
+/// Quadrature points of the cube models: the model's default (16 points, the controller's
+/// cost budget, README of `crate::model`).
+pub const CUBE_QUADRATURE_POINTS: usize = crate::model::cube::DEFAULT_QUADRATURE_POINTS;
+
+/// Quadrature nodes per period of the Dahl steady state (the gap integral; the Coulomb part
+/// is exact).
+pub const DAHL_QUADRATURE_POINTS: u32 = 64;
+
+/// One of the concrete friction models. The cube variant carries its quadrature tables (about
+/// 1 KB); there is no heap to box it into, and a plant or controller holds one model.
+#[derive(Debug, Clone, PartialEq)]
+#[allow(clippy::large_enum_variant)]
+pub enum AnyModel {
+    /// Littmann law on a Coulomb contact ([`ModelKind::Coulomb`]).
+    Coulomb(CoulombModel),
+    /// Exponential Coulomb law averaged over the vibration ([`ModelKind::ExpCoulomb`]).
+    ExpCoulomb(ExpCoulombVibrated),
+    /// Dahl contact in its periodic steady state ([`ModelKind::Dahl`]).
+    Dahl(DahlModel),
+    /// Cube model, elastic or elastic-plastic contact ([`ModelKind::CubeElastic`],
+    /// [`ModelKind::CubeElasticPlastic`]).
+    Cube(CubeModel),
+}
+
+impl AnyModel {
+    /// The model of `spec` (the scene's controller or plant spec) with the scene's hardware:
+    /// vibration amplitude at full command and drive frequency, and for the cube models the
+    /// horn (A = the actuator's full-scale amplitude, B, x, L). The project's default variants
+    /// are used: seed 000's E* rule, the surfaces-apart slip window, in-phase u, 16 points.
+    ///
+    /// Errors: the model's own validation, or `OutOfDomain` for a spec that lacks what its
+    /// kind needs (the scene loader never lets one through).
+    pub fn new(scene: &Scene<'_>, spec: &ModelSpec) -> Result<Self, ModelError> {
+        let frequency_hz = scene.transducer.drive_hz;
+        let amplitude_m = scene.actuator.full_scale_amplitude_m;
+        match spec.kind {
+            ModelKind::Coulomb => Ok(AnyModel::Coulomb(CoulombModel {
+                constants: CoulombConstants::new(spec.mu, frequency_hz, amplitude_m)?,
+            })),
+            ModelKind::ExpCoulomb => Ok(AnyModel::ExpCoulomb(ExpCoulombVibrated::new(
+                spec.mu_static.ok_or(missing("mu_s"))?,
+                spec.mu,
+                spec.decay_s_per_m.ok_or(missing("alpha_dc"))?,
+                core::f64::consts::TAU * frequency_hz * amplitude_m,
+            )?)),
+            ModelKind::Dahl => Ok(AnyModel::Dahl(DahlModel::new(&DahlParams {
+                friction_coefficient: spec.mu,
+                tangential_stiffness: spec.k_t_n_per_m.ok_or(missing("k_t"))?,
+                frequency_hz,
+                full_scale_amplitude_m: amplitude_m,
+                shape_exponent: spec.dahl_alpha.unwrap_or(1.0),
+                quadrature_points: DAHL_QUADRATURE_POINTS,
+            })?)),
+            ModelKind::CubeElastic | ModelKind::CubeElasticPlastic => {
+                let horn = scene.horn.ok_or(missing("horn"))?;
+                let surface = spec.surface.ok_or(missing("surface"))?;
+                let params = CubeParams {
+                    contact: contact_params(&surface),
+                    friction_coefficient: spec.mu,
+                    longitudinal_amplitude: amplitude_m,
+                    vertical_amplitude: horn.vertical_amplitude_m,
+                    position: horn.contact_position_m,
+                    horn_length: horn.length_m,
+                    frequency: frequency_hz,
+                };
+                let options = CubeOptions {
+                    e_star_rule: EStarRule::Seed000,
+                    contact_kind: if spec.kind == ModelKind::CubeElastic {
+                        ContactKind::Elastic
+                    } else {
+                        ContactKind::ElasticPlastic
+                    },
+                    window: SlipWindow::SurfacesApart,
+                    u_phase: UPhase::InPhase,
+                    quadrature_points: CUBE_QUADRATURE_POINTS,
+                };
+                Ok(AnyModel::Cube(CubeModel::new(&params, &options)?))
+            }
+        }
+    }
+
+    /// Which kind of model this is.
+    pub fn kind(&self) -> ModelKind {
+        match self {
+            AnyModel::Coulomb(_) => ModelKind::Coulomb,
+            AnyModel::ExpCoulomb(_) => ModelKind::ExpCoulomb,
+            AnyModel::Dahl(_) => ModelKind::Dahl,
+            AnyModel::Cube(model) => match model.scene().contact().scene().kind {
+                ContactKind::Elastic => ModelKind::CubeElastic,
+                ContactKind::ElasticPlastic => ModelKind::CubeElasticPlastic,
+            },
+        }
+    }
+}
+
+impl FrictionModel for AnyModel {
+    fn ratio(&self, point: &OperatingPoint, amplitude: Q1_31) -> Result<Q2_30, ModelError> {
+        match self {
+            AnyModel::Coulomb(model) => model.ratio(point, amplitude),
+            AnyModel::ExpCoulomb(model) => model.ratio(point, amplitude),
+            AnyModel::Dahl(model) => model.ratio(point, amplitude),
+            AnyModel::Cube(model) => model.ratio(point, amplitude),
+        }
+    }
+
+    fn invert(&self, point: &OperatingPoint, target: Q2_30) -> Result<Inversion, ModelError> {
+        match self {
+            AnyModel::Coulomb(model) => model.invert(point, target),
+            AnyModel::ExpCoulomb(model) => model.invert(point, target),
+            AnyModel::Dahl(model) => model.invert(point, target),
+            AnyModel::Cube(model) => model.invert(point, target),
+        }
+    }
+}
+
+fn missing(input: &'static str) -> ModelError {
+    ModelError::OutOfDomain {
+        input,
+        reason: "the scene's spec lacks what this model needs",
+    }
+}
+
+fn contact_params(surface: &RoughSurface) -> ContactParams {
+    ContactParams {
+        roughness_rq: surface.rq_m,
+        summit_radius: surface.rs_m,
+        nominal_area: surface.nominal_area_m2,
+        asperity_density: surface.asperity_density_per_m2,
+        distribution_c: surface.distribution_c,
+        distribution_lambda: surface.distribution_lambda,
+        young_1: surface.young_1_pa,
+        poisson_1: surface.poisson_1,
+        young_2: surface.young_2_pa,
+        poisson_2: surface.poisson_2,
+        poisson_soft: surface.poisson_soft,
+        yield_strength: surface.yield_strength_pa,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fx::{Q8_24, Q16_16};
+    use crate::scene::{SCENES, find};
+
+    fn point(load_n: f64, speed: f64) -> OperatingPoint {
+        OperatingPoint {
+            normal_force: Q16_16::from_f64_saturating(load_n).value,
+            sliding_velocity: Q8_24::from_f64_saturating(speed).value,
+        }
+    }
+
+    #[test]
+    fn every_scene_spec_builds_its_kind_and_vibration_lowers_friction() {
+        for scene in SCENES {
+            let at = point(
+                scene.normal_load_n[0].value,
+                scene.contents.velocity_max_m_per_s,
+            );
+            for spec in [&scene.controller, &scene.plant] {
+                let model = AnyModel::new(scene, spec).expect(scene.name);
+                assert_eq!(model.kind(), spec.kind, "{}", scene.name);
+                assert_eq!(
+                    model.ratio(&at, Q1_31::ZERO),
+                    Ok(Q2_30::ONE),
+                    "{}",
+                    scene.name
+                );
+                let full = model.ratio(&at, Q1_31::MAX).expect(scene.name);
+                assert!(full < Q2_30::ONE, "{}: {full:?}", scene.name);
+            }
+        }
+    }
+
+    #[test]
+    fn plant_models_agree_with_the_f64_reference() {
+        // Values of the host's f64 reference (host-tests/src/reference) at the scenes' first
+        // operating point with full amplitude: dahl_steady (mu 0.24, W 4.155 N, k_t 2e7 N/m,
+        // v 0.038 m/s, v_a 0.11953 m/s) 0.214808; cube_reduction elastic-plastic (Al/SS,
+        // 40 N, A 11.46 um, B 1.1 um, x = 0) 0.4806.
+        let reference = find("reference").expect("built in");
+        let dahl = AnyModel::new(reference, &reference.plant).expect("dahl");
+        let ratio = dahl.ratio(&point(4.155, 0.038), Q1_31::MAX).expect("ratio");
+        assert!((ratio.to_f64() - 0.214_808).abs() < 5e-4, "{ratio:?}");
+        let horn = find("load-ramp").expect("built in");
+        let cube = AnyModel::new(horn, &horn.plant).expect("cube");
+        let ratio = cube.ratio(&point(40.0, 0.005), Q1_31::MAX).expect("ratio");
+        assert!((ratio.to_f64() - 0.4806).abs() < 2e-3, "{ratio:?}");
+    }
+
+    #[test]
+    fn a_spec_missing_its_parameters_is_an_error() {
+        let reference = find("reference").expect("built in");
+        let no_stiffness = ModelSpec {
+            k_t_n_per_m: None,
+            ..reference.plant
+        };
+        assert!(AnyModel::new(reference, &no_stiffness).is_err());
+        let cube = ModelSpec {
+            kind: ModelKind::CubeElastic,
+            ..reference.plant
+        };
+        assert!(AnyModel::new(reference, &cube).is_err());
+    }
+}

@@ -1,0 +1,263 @@
+//! The simulated plant: a deterministic model of the transducer, the contact and the load
+//! cells, stepped at the control rate.
+//!
+//! A [`Plant`] is built from a [`Scene`] and a [`FrictionModel`] for its contact (normally
+//! [`AnyModel::new`] on the scene's plant spec: higher fidelity and its own parameters, so the
+//! controller has real model error to remove). Each [`Plant::step`] takes the drive command
+//! and frequency, holds them for one control period (zero-order hold), advances the
+//! transducer envelope, the contact and the cells' dynamics in `plant_substeps` substeps, and
+//! returns what the firmware would read at the end of the period: the two load cells' ADC
+//! codes (with bandwidth, calibration errors, noise, quantisation, saturation and the scene's
+//! faults), the sliding velocity, the drive current, and the ground truth for plots and pass
+//! criteria.
+//!
+//! # Determinism
+//!
+//! The physics is `f32` (the Cortex-M4F's FPU format); transcendental functions come from
+//! `libm` (pure Rust, no platform maths library); the noise comes from the plant's own seeded
+//! generator ([`noise`]); and Rust never contracts or reorders floating-point operations: the
+//! host and the firmware produce bit-identical runs for the same scene and the same inputs.
+//! Scene values are converted from `f64` once, at construction. Time is kept as the step
+//! count and formed as `step / rate` in `f64` (a few operations per substep), so profile
+//! breakpoints and fault onsets land on the control grid exactly, however long the run.
+
+pub mod any_model;
+pub mod contact;
+pub mod exp_average;
+pub mod noise;
+pub mod profile;
+pub mod sensors;
+pub mod transducer;
+
+pub use any_model::AnyModel;
+pub use contact::{Contact, ContactTruth};
+pub use exp_average::ExpCoulombVibrated;
+pub use noise::{Gaussian, Xoshiro128};
+pub use profile::{Scenario, ScenarioInputs};
+pub use sensors::LoadCellSim;
+pub use transducer::{CurrentPhasor, ResonantTransducer};
+
+use crate::model::{FrictionModel, ModelError};
+use crate::protocol::Target;
+use crate::scene::{Channel, FaultKind, Scene};
+
+/// Why a plant could not be built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum PlantError {
+    /// A scene value the plant needs is outside the range `scenes/README.md` gives (a scene
+    /// built by hand rather than by the loader).
+    InvalidScene {
+        /// The offending field.
+        field: &'static str,
+    },
+    /// The plant's friction model could not be built from the scene's plant spec.
+    Model(ModelError),
+}
+
+/// Ground truth of the plant at the end of a step, for plots and pass criteria.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct GroundTruth {
+    /// Time, s from the scene start.
+    pub time_s: f32,
+    /// Normal load, N.
+    pub normal_load_n: f32,
+    /// Sliding velocity, m/s, signed.
+    pub sliding_velocity_m_per_s: f32,
+    /// The contact: friction, natural friction, ratio, model error.
+    pub contact: ContactTruth,
+    /// Vibration amplitude, fraction of the scene's full-scale amplitude, [0, 1].
+    pub vibration_amplitude: f32,
+    /// Vibration amplitude, m.
+    pub vibration_amplitude_m: f32,
+    /// Transducer resonance f0 now, Hz.
+    pub resonance_hz: f32,
+    /// Gain of the transducer at the drive frequency now, (0, 1].
+    pub drive_gain: f32,
+    /// The drive command applied over the step, [0, 1].
+    pub drive_command: f32,
+    /// The drive frequency applied over the step, Hz.
+    pub drive_hz: f32,
+    /// The scene's target now.
+    pub target: Option<Target>,
+    /// The fault acting on the normal cell's sample, if any.
+    pub normal_fault: Option<FaultKind>,
+    /// The fault acting on the tangential cell's sample, if any.
+    pub tangential_fault: Option<FaultKind>,
+}
+
+/// What the firmware reads at the end of a step, and the ground truth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SensorReadings {
+    /// Steps taken so far (1 after the first step).
+    pub step: u32,
+    /// Normal-load cell, ADC code, 0 ..= 2^bits - 1 (zero force at mid-scale).
+    pub normal_code: u16,
+    /// Tangential (friction) cell, ADC code, 0 ..= 2^bits - 1 (zero force at mid-scale).
+    pub tangential_code: u16,
+    /// Sliding velocity from the carriage encoder, m/s, signed (exact).
+    pub sliding_velocity_m_per_s: f32,
+    /// Drive current at the drive frequency (for the resonance tracker).
+    pub drive_current: CurrentPhasor,
+    /// Ground truth.
+    pub truth: GroundTruth,
+}
+
+/// The simulated plant of one scene.
+#[derive(Debug, Clone)]
+pub struct Plant<'a, M> {
+    scenario: Scenario<'a>,
+    transducer: ResonantTransducer,
+    contact: Contact<M>,
+    normal_cell: LoadCellSim,
+    tangential_cell: LoadCellSim,
+    noise: Gaussian,
+    control_rate_hz: f64,
+    substeps: u8,
+    full_scale_amplitude_m: f32,
+    step: u32,
+    last_contact: ContactTruth,
+}
+
+impl<'a> Plant<'a, AnyModel> {
+    /// The plant of `scene` with the contact model of its plant spec ([`AnyModel::new`]).
+    pub fn from_scene(scene: &Scene<'a>) -> Result<Self, PlantError> {
+        let model = AnyModel::new(scene, &scene.plant).map_err(PlantError::Model)?;
+        Self::new(scene, model)
+    }
+}
+
+impl<'a, M: FrictionModel> Plant<'a, M> {
+    /// The plant of `scene` with `model` for its contact, at t = 0: drive off, cells settled
+    /// on the initial load and natural friction.
+    pub fn new(scene: &Scene<'a>, model: M) -> Result<Self, PlantError> {
+        let invalid = |field| Err(PlantError::InvalidScene { field });
+        if !(scene.control_rate_hz >= 1.0 && scene.control_rate_hz <= 1e6) {
+            return invalid("control_rate_hz");
+        }
+        if scene.plant_substeps == 0 {
+            return invalid("plant_substeps");
+        }
+        let t = &scene.transducer;
+        if !(t.resonance_hz > 0.0 && t.quality_factor > 0.0 && t.motional_resistance_ohm > 0.0) {
+            return invalid("transducer");
+        }
+        for cell in [&scene.normal_cell, &scene.tangential_cell] {
+            if !(cell.full_scale_n > 0.0 && (8..=16).contains(&cell.adc_bits)) {
+                return invalid("sensors");
+            }
+        }
+        let scenario = Scenario::new(scene);
+        let start = scenario.at(0.0);
+        let contact = Contact::new(model, &scene.plant);
+        let initial = contact.evaluate(start.normal_load_n, start.sliding_velocity_m_per_s, 0.0);
+        let substep_s = (1.0 / (scene.control_rate_hz * f64::from(scene.plant_substeps))) as f32;
+        Ok(Self {
+            scenario,
+            transducer: ResonantTransducer::new(&scene.transducer, &scene.actuator),
+            normal_cell: LoadCellSim::new(&scene.normal_cell, substep_s, start.normal_load_n),
+            tangential_cell: LoadCellSim::new(
+                &scene.tangential_cell,
+                substep_s,
+                initial.friction_n,
+            ),
+            contact,
+            noise: Gaussian::from_seed(scene.noise_seed),
+            control_rate_hz: scene.control_rate_hz,
+            substeps: scene.plant_substeps,
+            full_scale_amplitude_m: scene.actuator.full_scale_amplitude_m as f32,
+            step: 0,
+            last_contact: initial,
+        })
+    }
+
+    /// Time now, s from the scene start: steps / control rate.
+    pub fn time_s(&self) -> f32 {
+        self.time_f64() as f32
+    }
+
+    /// Steps taken so far.
+    pub fn steps(&self) -> u32 {
+        self.step
+    }
+
+    /// The transducer (envelope, electrical side, current waveform for lock-in tests).
+    pub fn transducer(&self) -> &ResonantTransducer {
+        &self.transducer
+    }
+
+    /// The contact and its friction model.
+    pub fn contact(&self) -> &Contact<M> {
+        &self.contact
+    }
+
+    /// The scene's inputs (load, velocity, target) at `t_s`.
+    pub fn inputs_at(&self, t_s: f32) -> ScenarioInputs {
+        self.scenario.at(t_s)
+    }
+
+    /// One control period with `drive_command` (fraction of full-scale voltage, clamped to
+    /// [0, 1]) at `drive_hz` held: returns the readings at the end of the period.
+    pub fn step(&mut self, drive_command: f32, drive_hz: f32) -> SensorReadings {
+        let start_s = self.time_f64();
+        let substep_s = 1.0 / (self.control_rate_hz * f64::from(self.substeps));
+        let mut inputs = self.scenario.at(start_s as f32);
+        for k in 1..=self.substeps {
+            self.transducer
+                .advance(drive_command, drive_hz, substep_s as f32);
+            inputs = self
+                .scenario
+                .at((start_s + f64::from(k) * substep_s) as f32);
+            let amplitude = self.transducer.envelope();
+            self.last_contact = self.contact.evaluate(
+                inputs.normal_load_n,
+                inputs.sliding_velocity_m_per_s,
+                amplitude,
+            );
+            self.normal_cell.track(inputs.normal_load_n);
+            self.tangential_cell.track(self.last_contact.friction_n);
+        }
+        self.step = self.step.saturating_add(1);
+        let now = self.time_f64();
+        let normal_fault = self.scenario.fault_at(Channel::Normal, self.step);
+        let tangential_fault = self.scenario.fault_at(Channel::Tangential, self.step);
+        let normal_code = self.normal_cell.sample(&mut self.noise, normal_fault);
+        let tangential_code = self
+            .tangential_cell
+            .sample(&mut self.noise, tangential_fault);
+        let time_s = now as f32;
+        let amplitude = self.transducer.envelope();
+        SensorReadings {
+            step: self.step,
+            normal_code,
+            tangential_code,
+            sliding_velocity_m_per_s: inputs.sliding_velocity_m_per_s,
+            drive_current: self.transducer.current(),
+            truth: GroundTruth {
+                time_s,
+                normal_load_n: inputs.normal_load_n,
+                sliding_velocity_m_per_s: inputs.sliding_velocity_m_per_s,
+                contact: self.last_contact,
+                vibration_amplitude: amplitude,
+                vibration_amplitude_m: amplitude * self.full_scale_amplitude_m,
+                resonance_hz: self.transducer.resonance_hz(time_s),
+                drive_gain: self.transducer.gain(drive_hz, time_s),
+                drive_command: self.transducer.command(),
+                drive_hz,
+                target: inputs.target,
+                normal_fault,
+                tangential_fault,
+            },
+        }
+    }
+
+    fn time_f64(&self) -> f64 {
+        f64::from(self.step) / self.control_rate_hz
+    }
+}
+
+#[cfg(test)]
+#[path = "plant_tests.rs"]
+mod tests;

@@ -1,0 +1,61 @@
+//! The scenes compiled into the firmware.
+//!
+//! The build script (`build.rs`) reads every `scenes/*.toml` with the `scene-toml` crate, which
+//! validates it exactly as the host loader does, and writes them as one `static` slice to
+//! `$OUT_DIR/scenes.rs`, included here. Editing a scene file rebuilds the crate.
+
+#[allow(unused_imports)]
+use super::{
+    Accuracy, Actuator, ActuatorKind, Breakpoint, Channel, Contents, Criterion, FaultEvent,
+    FaultKind, Horn, LoadCell, Mismatch, ModelKind, ModelSpec, Rail, RoughSurface, Scene, Stack,
+    System, TargetPoint, Transducer,
+};
+#[allow(unused_imports)]
+use crate::protocol::Target;
+
+include!(concat!(env!("OUT_DIR"), "/scenes.rs"));
+
+/// The built-in scene named `name` (the `scene <name>` command), if any.
+pub fn find(name: &str) -> Option<&'static Scene<'static>> {
+    SCENES.iter().find(|scene| scene.name == name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::protocol::is_scene_name;
+
+    #[test]
+    fn every_scene_is_found_by_its_valid_unique_name() {
+        assert!(!SCENES.is_empty());
+        for scene in SCENES {
+            assert!(is_scene_name(scene.name), "{}", scene.name);
+            let found = find(scene.name).map(|s| s as *const Scene<'static>);
+            assert_eq!(
+                found,
+                Some(scene as *const Scene<'static>),
+                "{}",
+                scene.name
+            );
+        }
+        assert!(find("no-such-scene").is_none());
+    }
+
+    #[test]
+    fn the_compiled_in_data_stays_small() {
+        // Flash budget of the scene table (structs, not counting strings and tables), for
+        // the 32-bit target and the 64-bit host alike.
+        let bytes = core::mem::size_of_val(SCENES);
+        assert!(bytes < 12_000, "{bytes} bytes");
+    }
+
+    #[test]
+    fn the_acceptance_scenes_are_built_in() {
+        for name in ["reference", "load-ramp", "sensor-fault"] {
+            assert!(find(name).is_some(), "{name} is missing");
+        }
+        let reference = find("reference").map(|s| s.transducer.envelope_time_constant_s());
+        let tau = reference.unwrap_or(0.0);
+        assert!((tau - 0.000_795_8).abs() < 1e-7, "tau = {tau}");
+    }
+}

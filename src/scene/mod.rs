@@ -1,0 +1,122 @@
+//! Scenes: named operating scenarios, compiled into the firmware and loadable on the host.
+//!
+//! A [`Scene`] holds everything a closed-loop run needs: the materials and surface, the
+//! actuator, the horn geometry and contact position, the resonant transducer, the load cells,
+//! the profiles of normal load, sliding velocity and target over time, the sensor faults to
+//! inject, the controller's model and the plant's (higher-fidelity) model with their own
+//! parameters, the mismatch between them, the accuracy it needs, its pass criteria and what it
+//! contains (vibration components, load and velocity ranges).
+//!
+//! Scenes are written in `scenes/*.toml` (schema: `scenes/README.md`). The build script reads
+//! them with the `scene-toml` crate and compiles every one in as `static` data
+//! ([`builtin::SCENES`], [`find`]); the host loads any file into the same type. Every slice and
+//! string is borrowed (`'static` for the built-in scenes), so a scene lives in flash and costs
+//! no RAM.
+//!
+//! # Numbers
+//!
+//! Scalars and table entries are SI `f64`, exactly the values of the file: the model constants
+//! are built from them in `f64` once per scene (see [`crate::model`]). The per-step evaluation
+//! of the profiles ([`interpolate`], [`target_at`]) is in `f32`, the plant's format.
+
+pub mod builtin;
+mod criteria;
+mod fault;
+mod hardware;
+mod spec;
+mod table;
+
+pub use builtin::{SCENES, find};
+pub use criteria::{Accuracy, Contents, Criterion};
+pub use fault::{Channel, FaultEvent, FaultKind, Rail};
+pub use hardware::{Actuator, ActuatorKind, Horn, LoadCell, Stack, Transducer};
+pub use spec::{Mismatch, ModelKind, ModelSpec, RoughSurface};
+pub use table::{Breakpoint, TargetPoint, interpolate, target_at};
+
+/// Which system of the source papers a scene belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum System {
+    /// Seed 003: PMN-PT stack transducer sliding on an aluminium guide rail, 40 kHz, 0-10 N
+    /// added load.
+    StackOnRail,
+    /// Seeds 000/001: Poisson-effect horn (waveguide) over a sliding block, 20 kHz, 40-240 N.
+    PoissonHorn,
+    /// Seed 002: flexible beam on a moving table (stick-slip rig), exponential Coulomb law,
+    /// with an ultrasonic actuator added at the beam tip.
+    BeamOnTable,
+    /// Application: seat-belt webbing sliding over a vibrated D-ring (seed 003 names seat-belt
+    /// systems as its future work).
+    SeatBelt,
+}
+
+/// A named operating scenario. Field units are in the names (`_hz`, `_s`, `_n`, `_m_per_s`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scene<'a> {
+    /// Name, the `scene <name>` of the protocol: 1 to 24 bytes of `[a-z0-9_-]`, unique.
+    pub name: &'a str,
+    /// One or two sentences for a person, printable ASCII, at most 200 bytes.
+    pub description: &'a str,
+    /// The system of the source papers.
+    pub system: System,
+    /// The materials in contact, in words (`"Al horn / SS block"`), at most 60 bytes.
+    pub materials: &'a str,
+    /// Control-loop rate, which is also the plant's step rate, Hz, 1e3 ..= 1e5 (default 1e4).
+    pub control_rate_hz: f64,
+    /// Length of the run, s, (0, 60].
+    pub duration_s: f64,
+    /// Plant substeps per control step, 1 ..= 16 (default 4).
+    pub plant_substeps: u8,
+    /// Seed of the plant's sensor-noise generator (any value; default 1).
+    pub noise_seed: u64,
+    /// The model the controller uses.
+    pub controller: ModelSpec,
+    /// The model the plant uses: of higher fidelity than the controller's, own parameters.
+    pub plant: ModelSpec,
+    /// Plant over controller parameters, derived from the two specs.
+    pub mismatch: Mismatch,
+    /// Vibration source.
+    pub actuator: Actuator,
+    /// Horn geometry and contact position, for horn systems (required by the cube models).
+    pub horn: Option<Horn>,
+    /// Resonant transducer: envelope dynamics and electrical model.
+    pub transducer: Transducer,
+    /// The normal-load cell.
+    pub normal_cell: LoadCell,
+    /// The tangential (friction) cell.
+    pub tangential_cell: LoadCell,
+    /// Sensor faults to inject, in order of onset.
+    pub faults: &'a [FaultEvent],
+    /// Normal load over time, N, piecewise linear, values in [0, normal full scale).
+    pub normal_load_n: &'a [Breakpoint],
+    /// Sliding velocity over time, m/s (signed), piecewise linear, |v| < 10.
+    pub sliding_velocity_m_per_s: &'a [Breakpoint],
+    /// Target over time: steps and ramps of protocol targets.
+    pub target: &'a [TargetPoint],
+    /// Accuracy the scene needs.
+    pub accuracy: Accuracy,
+    /// Pass criteria for the closed-loop runner (at least one).
+    pub criteria: &'a [Criterion],
+    /// What the scene contains, for choosing the cheapest adequate model variant.
+    pub contents: Contents,
+}
+
+impl Scene<'_> {
+    /// Control period, s (1 / `control_rate_hz`).
+    pub fn control_period_s(&self) -> f64 {
+        1.0 / self.control_rate_hz
+    }
+
+    /// Number of control steps in the run: `duration_s * control_rate_hz`, rounded up.
+    pub fn step_count(&self) -> u32 {
+        let steps = libm::ceil(self.duration_s * self.control_rate_hz - 1e-9);
+        // duration <= 60 s and rate <= 1e5 Hz bound this by 6e6.
+        steps as u32
+    }
+
+    /// Vibration velocity amplitude at full command on resonance, m/s: 2 pi f0 x_a (seed 003
+    /// eq 2), at the scene's starting drive frequency.
+    pub fn full_scale_vibration_velocity_m_per_s(&self) -> f64 {
+        core::f64::consts::TAU * self.transducer.drive_hz * self.actuator.full_scale_amplitude_m
+    }
+}
