@@ -18,3 +18,4 @@ pub mod resonance;
 pub mod scene;
 pub mod selfcheck;
 pub mod sense;
+pub mod sim;

@@ -17,6 +17,11 @@ const SUBCOMMANDS: &[Subcommand] = &[
         "paper numbers vs reference vs fixed point (markdown)",
         sonolube_host::cli::papers::run,
     ),
+    (
+        "scene",
+        "run a scene closed loop: CSV, SVG and metrics",
+        sonolube_host::cli::scene::run,
+    ),
 ];
 
 fn usage() -> String {

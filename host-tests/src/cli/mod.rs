@@ -2,3 +2,4 @@
 //! `pub fn run(args: &[String]) -> std::process::ExitCode` (the arguments after its name).
 pub mod eval;
 pub mod papers;
+pub mod scene;

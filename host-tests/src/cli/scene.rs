@@ -1,0 +1,191 @@
+//! `sonolube scene`: runs a scene closed loop on the host ([`sonolube::sim::ClosedLoop`]),
+//! writes its time series as CSV and an SVG plot, and prints the metrics and the verdict of
+//! each of the scene's criteria.
+//!
+//! ```text
+//! sonolube scene NAME [--out DIR] [--file PATH.toml]
+//! sonolube scene --all [--out DIR]
+//! ```
+//!
+//! `NAME` is a built-in scene (`scenes/*.toml`, compiled in); `--file` runs any scene file
+//! (its `name` must match `NAME` when both are given). Files go to `DIR` (default
+//! `target/scenes/`): `NAME.csv` and `NAME.svg`. Exit status: 0 when every criterion passes,
+//! 1 when one fails (or a scene cannot run), 2 for a usage error. The output is deterministic.
+//!
+//! # CSV columns
+//!
+//! One row per control step; friction forces are magnitudes.
+//!
+//! | column | unit | meaning |
+//! |---|---|---|
+//! | `step` | 1 | control step, from 1 |
+//! | `time_s` | s | time of the step's sample |
+//! | `target` | | the scene's target, `kind:value` as in the protocol |
+//! | `target_friction_n` | N | friction the target asks for (from the plant's true natural friction or load) |
+//! | `estimated_friction_n` | N | the controller's filtered friction measurement |
+//! | `true_friction_n` | N | the plant's friction |
+//! | `quantity` | | what the criteria judge: `ratio`, `coef` or `force_n` |
+//! | `target_value`, `true_value` | quantity | target and plant value in that quantity |
+//! | `error_pct` | % | `(true - target) / target` |
+//! | `drive_amplitude` | fraction of full scale | drive command for the next period |
+//! | `vibration_amplitude` | fraction of full scale | the transducer's envelope |
+//! | `normal_load_n` | N | the plant's normal load |
+//! | `state`, `reason` | | supervisor state and reason of its last transition |
+//! | `at_limit` | 0/1 | drive command at the actuator's ceiling |
+//! | `sensor_fault` | | fault the sensing chain found (`-` for none) |
+//! | `injected_fault` | 0/1 | a scene fault acts on the sample |
+
+mod csv;
+mod figure;
+mod report;
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use crate::scene_file::LoadedScene;
+use figure::svg;
+use report::{pass, report, short};
+use sonolube::scene::{SCENES, Scene};
+use sonolube::sim::{ClosedLoop, RunSummary};
+
+pub use csv::csv;
+
+const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml]\n       \
+                     sonolube scene --all [--out DIR]\n";
+
+/// Entry point: `args` are the arguments after `scene`.
+pub fn run(args: &[String]) -> ExitCode {
+    let mut name = None;
+    let mut out = PathBuf::from("target/scenes");
+    let mut file = None;
+    let mut all = false;
+    let mut rest = args.iter();
+    while let Some(arg) = rest.next() {
+        match arg.as_str() {
+            "--all" => all = true,
+            "--out" | "--file" => {
+                let Some(value) = rest.next() else {
+                    return usage(&format!("{arg} needs a value"));
+                };
+                if arg == "--out" {
+                    out = PathBuf::from(value);
+                } else {
+                    file = Some(PathBuf::from(value));
+                }
+            }
+            "-h" | "--help" => {
+                print!("{USAGE}");
+                return ExitCode::SUCCESS;
+            }
+            flag if flag.starts_with('-') => return usage(&format!("unknown option {flag}")),
+            _ if name.is_none() => name = Some(arg.clone()),
+            _ => return usage(&format!("unexpected argument {arg}")),
+        }
+    }
+    if all {
+        if name.is_some() || file.is_some() {
+            return usage("--all takes no scene name and no --file");
+        }
+        return run_all(&out);
+    }
+    let loaded;
+    let scene = match (&file, &name) {
+        (Some(path), _) => {
+            loaded = match LoadedScene::load(path) {
+                Ok(loaded) => loaded,
+                Err(error) => return usage(&error.to_string()),
+            };
+            let scene = loaded.scene();
+            if name.as_deref().is_some_and(|n| n != scene.name) {
+                return usage(&format!("{} holds scene '{}'", path.display(), scene.name));
+            }
+            scene
+        }
+        (None, Some(name)) => match sonolube::scene::find(name) {
+            Some(scene) => *scene,
+            None => return usage(&format!("no scene '{name}' (built in: {})", names())),
+        },
+        (None, None) => return usage("a scene NAME, --file or --all is needed"),
+    };
+    match run_one(&scene, &out) {
+        Ok((summary, report)) => {
+            print!("{report}");
+            exit(summary.passed())
+        }
+        Err(error) => {
+            eprintln!("sonolube scene {}: {error}", scene.name);
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn usage(problem: &str) -> ExitCode {
+    eprint!("sonolube scene: {problem}\n{USAGE}");
+    ExitCode::from(2)
+}
+
+fn exit(passed: bool) -> ExitCode {
+    if passed {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}
+
+fn names() -> String {
+    SCENES.iter().map(|s| s.name).collect::<Vec<_>>().join(", ")
+}
+
+fn run_all(out: &Path) -> ExitCode {
+    let (mut passed, mut failed) = (0, 0);
+    for scene in SCENES {
+        let line = match run_one(scene, out) {
+            Ok((summary, _)) => {
+                let verdicts: Vec<String> = summary
+                    .verdicts
+                    .iter()
+                    .map(|v| short(&v.criterion, v.measured))
+                    .collect();
+                let ok = summary.passed();
+                if ok {
+                    passed += 1
+                } else {
+                    failed += 1
+                }
+                format!("{} {:<13} {}", pass(ok), scene.name, verdicts.join(", "))
+            }
+            Err(error) => {
+                failed += 1;
+                format!("FAIL {:<13} cannot run: {error}", scene.name)
+            }
+        };
+        println!("{line}");
+    }
+    println!("{passed} passed, {failed} failed");
+    exit(failed == 0)
+}
+
+/// Runs `scene`, writes its CSV and SVG to `out`, returns the summary and the report text.
+pub fn run_one(scene: &Scene<'_>, out: &Path) -> Result<(RunSummary, String), String> {
+    let mut sim = ClosedLoop::new(scene).map_err(|e| format!("cannot build the run: {e:?}"))?;
+    let mut records = Vec::with_capacity(scene.step_count() as usize);
+    while let Some(record) = sim.step() {
+        records.push(record);
+    }
+    let summary = sim.summary();
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let csv_path = out.join(format!("{}.csv", scene.name));
+    let svg_path = out.join(format!("{}.svg", scene.name));
+    std::fs::write(&csv_path, csv(&records)).map_err(|e| format!("{}: {e}", csv_path.display()))?;
+    std::fs::write(&svg_path, svg(scene, &summary, &records))
+        .map_err(|e| format!("{}: {e}", svg_path.display()))?;
+    let mut text = report(scene, &summary, &records);
+    let _ = writeln!(
+        text,
+        "  wrote {} and {}",
+        csv_path.display(),
+        svg_path.display()
+    );
+    Ok((summary, text))
+}
