@@ -66,8 +66,9 @@ pub async fn heartbeat(mut on_wakeup: impl FnMut(u32)) -> ! {
     }
 }
 
-/// The supervisor task body: logs the heartbeat's reports, then ends the run with the verdict.
-pub async fn supervisor<B: Board>() -> ! {
+/// Waits for the heartbeat's reports, logs them and judges the run: true when the self-check
+/// passed (the verdict is logged either way).
+pub async fn self_check<B: Board>() -> bool {
     let mut last: Option<Report> = None;
     for _ in 0..REPORTS {
         let report = REPORTS_CHANNEL.receive().await;
@@ -90,9 +91,14 @@ pub async fn supervisor<B: Board>() -> ! {
     };
     if verdict == PeriodVerdict::Pass {
         defmt::info!("self-check passed on {}: {}", B::NAME, verdict);
-        B::finish(true)
+        true
     } else {
         defmt::error!("self-check FAILED on {}: {}", B::NAME, verdict);
-        B::finish(false)
+        false
     }
+}
+
+/// The supervisor task body: the self-check, then the end of the run with its verdict.
+pub async fn supervisor<B: Board>() -> ! {
+    B::finish(self_check::<B>().await)
 }

@@ -18,6 +18,7 @@
 mod drive;
 mod executor;
 mod exit;
+mod scene_run;
 mod time_driver;
 mod watchdog;
 
@@ -92,9 +93,20 @@ async fn watchdog_task() {
     }
 }
 
+/// The scene the firmware runs after its self-check.
+const DEFAULT_SCENE: &str = "reference";
+
 #[embassy_executor::task]
 async fn supervisor_task() {
-    heartbeat::supervisor::<Qemu>().await
+    if !heartbeat::self_check::<Qemu>().await {
+        exit::exit(exit::SELFCHECK_FAILED);
+    }
+    let Some(scene) = sonolube::scene::builtin::find(DEFAULT_SCENE) else {
+        defmt::error!("no scene named {=str}", DEFAULT_SCENE);
+        exit::exit(exit::SELFCHECK_FAILED);
+    };
+    let passed = scene_run::run(scene).await;
+    Qemu::finish(passed)
 }
 
 #[cortex_m_rt::entry]

@@ -183,6 +183,12 @@ embassy_time_driver::time_driver_impl!(static DRIVER: SysTickDriver = SysTickDri
     queue: Mutex::new(RefCell::new(Queue::new())),
 });
 
+/// Core cycles (25 MHz) since boot. Under `-icount shift=N` one cycle is 40 ns of virtual time,
+/// that is 40 / 2^N guest instructions.
+pub fn cycles() -> u64 {
+    critical_section::with(|cs| DRIVER.clock.borrow_ref_mut(cs).now_cycles())
+}
+
 /// Starts SysTick as the time base. Call once, before the executor runs.
 pub fn init(mut syst: SYST) {
     syst.disable_counter();
