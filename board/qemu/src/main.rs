@@ -15,6 +15,7 @@
 #![no_std]
 #![no_main]
 
+mod bench;
 mod drive;
 mod executor;
 mod exit;
@@ -105,7 +106,11 @@ async fn supervisor_task() {
         defmt::error!("no scene named {=str}", DEFAULT_SCENE);
         exit::exit(exit::SELFCHECK_FAILED);
     };
-    let passed = scene_run::run(scene).await;
+    let passed = if cfg!(feature = "bench") {
+        bench::run()
+    } else {
+        scene_run::run(scene).await
+    };
     Qemu::finish(passed)
 }
 
