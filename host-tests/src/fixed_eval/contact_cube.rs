@@ -18,8 +18,9 @@
 //! (1..=64, default 16) where the reference ignores it; F'/F outside [-128, 128) (off the node)
 //! is an error (flagged saturation of the Q8.24 ratio) where the reference returns the number.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 
+use super::keys::Keys;
 use sonolube::fx::Q2_30;
 use sonolube::model::ModelError;
 use sonolube::model::contact::{
@@ -30,8 +31,7 @@ use sonolube::model::horn::{HornShape, PoissonGain, UPhase, amplitude_um, time_p
 use sonolube::model::quadrature::SlipWindow;
 use sonolube::model::scaled::Scaled;
 
-/// Output map: key -> value in SI units (percent for `reduction_pct`).
-pub type Outputs = BTreeMap<&'static str, f64>;
+pub use super::Outputs;
 
 /// The models this module evaluates.
 pub const MODELS: &[&str] = &[
@@ -53,13 +53,7 @@ pub fn eval_fixed_contact_cube(
     variant: &BTreeMap<String, String>,
 ) -> Option<Result<Outputs, String>> {
     let name = *MODELS.iter().find(|known| **known == model)?;
-    let mut keys = Keys {
-        model: name,
-        inputs,
-        variant,
-        read_inputs: BTreeSet::new(),
-        read_variants: BTreeSet::new(),
-    };
+    let mut keys = Keys::new(name, inputs, variant);
     let result = match name {
         "contact_ep" => contact(&mut keys, false),
         "contact_el" => contact(&mut keys, true),
@@ -68,58 +62,13 @@ pub fn eval_fixed_contact_cube(
         "horn_kinematics" => horn(&mut keys),
         _ => poisson_amplitude(&mut keys),
     };
-    Some(result.and_then(|outputs| keys.finish().map(|()| outputs)))
-}
-
-/// Reads inputs and variants by key, remembering them to report unknown keys.
-struct Keys<'a> {
-    model: &'static str,
-    inputs: &'a BTreeMap<String, f64>,
-    variant: &'a BTreeMap<String, String>,
-    read_inputs: BTreeSet<&'static str>,
-    read_variants: BTreeSet<&'static str>,
+    Some(result.and_then(|outputs| keys.finish().map(|_| outputs)))
 }
 
 impl Keys<'_> {
-    fn optional(&mut self, key: &'static str) -> Result<Option<f64>, String> {
-        self.read_inputs.insert(key);
-        match self.inputs.get(key) {
-            Some(value) if !value.is_finite() => {
-                Err(format!("{}: input {key} is not finite", self.model))
-            }
-            other => Ok(other.copied()),
-        }
-    }
-
-    fn get(&mut self, key: &'static str) -> Result<f64, String> {
-        self.optional(key)?
-            .ok_or_else(|| format!("{}: missing input {key}", self.model))
-    }
-
-    fn choose<T: Copy>(&mut self, key: &'static str, choices: &[(&str, T)]) -> Result<T, String> {
-        self.read_variants.insert(key);
-        match self.variant.get(key) {
-            None => Ok(choices[0].1),
-            Some(text) => choices
-                .iter()
-                .find(|(name, _)| name == text)
-                .map(|&(_, value)| value)
-                .ok_or_else(|| format!("{}: unknown value {text:?} of variant {key}", self.model)),
-        }
-    }
-
-    fn quadrature_points(&mut self) -> Result<usize, String> {
-        self.read_variants.insert("quadrature_points");
-        match self.variant.get("quadrature_points") {
-            None => Ok(DEFAULT_QUADRATURE_POINTS),
-            Some(text) => match text.trim().parse::<usize>() {
-                Ok(n) if n >= 1 => Ok(n),
-                _ => Err(format!(
-                    "{}: quadrature_points must be a whole number >= 1",
-                    self.model
-                )),
-            },
-        }
+    fn quadrature_nodes(&mut self) -> Result<usize, String> {
+        self.quadrature_points(DEFAULT_QUADRATURE_POINTS as u32)
+            .map(|n| n as usize)
     }
 
     fn e_star_rule(&mut self) -> Result<EStarRule, String> {
@@ -130,24 +79,6 @@ impl Keys<'_> {
                 ("seed001", EStarRule::Seed001),
             ],
         )
-    }
-
-    fn finish(self) -> Result<(), String> {
-        if let Some(key) = self
-            .inputs
-            .keys()
-            .find(|k| !self.read_inputs.contains(k.as_str()))
-        {
-            return Err(format!("{}: unknown input {key}", self.model));
-        }
-        if let Some(key) = self
-            .variant
-            .keys()
-            .find(|k| !self.read_variants.contains(k.as_str()))
-        {
-            return Err(format!("{}: unknown variant {key}", self.model));
-        }
-        Ok(())
     }
 
     /// The contact set; `nu_soft` and `Y0` are optional (and unread) for the elastic model.
@@ -255,7 +186,7 @@ fn contact_of_separation(keys: &mut Keys<'_>) -> Result<Outputs, String> {
 }
 
 fn cube(keys: &mut Keys<'_>) -> Result<Outputs, String> {
-    let points = keys.quadrature_points()?;
+    let points = keys.quadrature_nodes()?;
     let options = CubeOptions {
         e_star_rule: keys.e_star_rule()?,
         contact_kind: keys.choose(

@@ -21,8 +21,9 @@
 //! the fixed formats (|v| >= 32768 m/s, loads >= 8e6 N, x_a >= 128 um, I >= 128 A, V >= 32768 V)
 //! are errors where the reference returns a number.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 
+use super::keys::Keys;
 use sonolube::fx::{Q, Q1_31, Q2_30, Q8_24, Q16_16};
 use sonolube::model::ModelError;
 use sonolube::model::actuator::{ActuatorConstants, ActuatorParams};
@@ -36,11 +37,9 @@ use sonolube::model::littmann::mu_i;
 use sonolube::model::scaled::Scaled;
 use sonolube::model::wide;
 
-/// Output map: key -> value in SI units (percent for `reduction_pct`).
-pub type Outputs = BTreeMap<&'static str, f64>;
+pub use super::Outputs;
 
-/// Input map: key -> value in SI units.
-pub type Inputs = BTreeMap<String, f64>;
+pub use super::Inputs;
 
 /// Outputs, and the inputs as the fixed-point path represented them.
 pub type QuantizedEvaluation = (Outputs, Inputs);
@@ -80,14 +79,7 @@ pub fn eval_with_quantized_inputs(
     variant: &BTreeMap<String, String>,
 ) -> Option<Result<QuantizedEvaluation, String>> {
     let name = *MODELS.iter().find(|known| **known == model)?;
-    let mut keys = Keys {
-        model: name,
-        inputs,
-        variant,
-        read_inputs: BTreeSet::new(),
-        read_variants: BTreeSet::new(),
-        quantized: inputs.clone(),
-    };
+    let mut keys = Keys::new(name, inputs, variant);
     let result = match name {
         "littmann_mu_i" => littmann(&mut keys),
         "coulomb_avg_friction" => coulomb_average(&mut keys),
@@ -100,75 +92,7 @@ pub fn eval_with_quantized_inputs(
     Some(result.and_then(|outputs| keys.finish().map(|quantized| (outputs, quantized))))
 }
 
-/// Reads inputs and variants by key (to report unknown keys) and records quantised values.
-struct Keys<'a> {
-    model: &'static str,
-    inputs: &'a BTreeMap<String, f64>,
-    variant: &'a BTreeMap<String, String>,
-    read_inputs: BTreeSet<&'static str>,
-    read_variants: BTreeSet<&'static str>,
-    quantized: Inputs,
-}
-
 impl Keys<'_> {
-    fn get(&mut self, key: &'static str) -> Result<f64, String> {
-        self.read_inputs.insert(key);
-        match self.inputs.get(key) {
-            None => Err(format!("{}: missing input {key}", self.model)),
-            Some(v) if !v.is_finite() => Err(format!("{}: input {key} is not finite", self.model)),
-            Some(&v) => Ok(v),
-        }
-    }
-
-    fn get_or(&mut self, key: &'static str, default: f64) -> Result<f64, String> {
-        if self.inputs.contains_key(key) {
-            self.get(key)
-        } else {
-            self.read_inputs.insert(key);
-            Ok(default)
-        }
-    }
-
-    fn record(&mut self, key: &'static str, value: f64) {
-        if self.inputs.contains_key(key) {
-            self.quantized.insert(key.to_string(), value);
-        }
-    }
-
-    /// `quadrature_points`: a whole number >= 1 (the reference's rule); the Dahl models also
-    /// need it even and within 4..=4096.
-    fn quadrature_points(&mut self) -> Result<u32, String> {
-        self.read_variants.insert("quadrature_points");
-        match self.variant.get("quadrature_points") {
-            None => Ok(DEFAULT_QUADRATURE_POINTS),
-            Some(text) => match text.trim().parse::<u32>() {
-                Ok(n) if n >= 1 => Ok(n),
-                _ => Err(format!(
-                    "{}: quadrature_points must be a whole number >= 1",
-                    self.model
-                )),
-            },
-        }
-    }
-
-    fn finish(self) -> Result<Inputs, String> {
-        let unknown_input = self
-            .inputs
-            .keys()
-            .find(|k| !self.read_inputs.contains(k.as_str()));
-        if let Some(key) = unknown_input {
-            return Err(format!("{}: unknown input {key}", self.model));
-        }
-        let unknown_variant = self
-            .variant
-            .keys()
-            .find(|k| !self.read_variants.contains(k.as_str()));
-        if let Some(key) = unknown_variant {
-            return Err(format!("{}: unknown variant {key}", self.model));
-        }
-        Ok(self.quantized)
-    }
-
     fn err(&self) -> impl Fn(ModelError) -> String + '_ {
         move |e| format!("{}: {e}", self.model)
     }
@@ -299,7 +223,7 @@ fn littmann(keys: &mut Keys<'_>) -> Result<Outputs, String> {
 }
 
 fn coulomb_average(keys: &mut Keys<'_>) -> Result<Outputs, String> {
-    keys.quadrature_points()?; // a closed form: validated, not used
+    keys.quadrature_points(DEFAULT_QUADRATURE_POINTS)?; // a closed form: validated, not used
     let mu = keys.coefficient("mu")?;
     let frequency = keys.get("f")?;
     let (full_scale, amplitude) = keys.amplitude("x_a")?;
@@ -350,7 +274,7 @@ fn coulomb_sampled(keys: &mut Keys<'_>) -> Result<Outputs, String> {
 
 /// Dahl scene parameters from the keys; returns them, the amplitude and the load.
 fn dahl_scene(keys: &mut Keys<'_>, alpha: f64) -> Result<(DahlParams, Q1_31, Load, Speed), String> {
-    let points = keys.quadrature_points()?;
+    let points = keys.quadrature_points(DEFAULT_QUADRATURE_POINTS)?;
     let mu = keys.coefficient("mu")?;
     let stiffness = keys.get("k_t")?;
     let frequency = keys.get("f")?;

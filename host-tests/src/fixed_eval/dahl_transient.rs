@@ -12,39 +12,22 @@ use sonolube::fx::{Q2_30, Q8_24};
 use sonolube::model::dahl::update;
 
 use super::Outputs;
-
-const INPUTS: [&str; 5] = ["F_t0", "K_t", "v_rel", "t", "delta0"];
+use super::keys::Keys;
 
 /// Evaluates `dahl_delta_transient` in fixed point; outputs `delta` and `delta_ss` (m).
 pub fn eval(
     inputs: &BTreeMap<String, f64>,
     variant: &BTreeMap<String, String>,
 ) -> Result<Outputs, String> {
-    if let Some(key) = variant.keys().next() {
-        return Err(format!(
-            "dahl_delta_transient takes no variant (got `{key}`)"
-        ));
-    }
-    if let Some(key) = inputs.keys().find(|k| !INPUTS.contains(&k.as_str())) {
-        return Err(format!("dahl_delta_transient: unknown input `{key}`"));
-    }
-    let get = |key: &str| -> Result<f64, String> {
-        let value = *inputs
-            .get(key)
-            .ok_or_else(|| format!("dahl_delta_transient: missing input `{key}`"))?;
-        if value.is_finite() {
-            Ok(value)
-        } else {
-            Err(format!("dahl_delta_transient: input `{key}` is not finite"))
-        }
-    };
+    let mut keys = Keys::new("dahl_delta_transient", inputs, variant);
     let (force, stiffness, v_rel, time, delta0) = (
-        get("F_t0")?,
-        get("K_t")?,
-        get("v_rel")?,
-        get("t")?,
-        get("delta0")?,
+        keys.get("F_t0")?,
+        keys.get("K_t")?,
+        keys.get("v_rel")?,
+        keys.get("t")?,
+        keys.get("delta0")?,
     );
+    keys.finish()?;
     if force <= 0.0 || stiffness <= 0.0 {
         return Err("dahl_delta_transient: F_t0 and K_t must be > 0".into());
     }

@@ -4,11 +4,15 @@
 pub mod contact_cube;
 pub mod coulomb_dahl;
 pub mod dahl_transient;
+mod keys;
 
 use std::collections::BTreeMap;
 
 /// Output map: key -> value in SI units (percent for `*_pct`).
 pub type Outputs = BTreeMap<&'static str, f64>;
+
+/// Input map: key -> value in SI units.
+pub type Inputs = BTreeMap<String, f64>;
 
 /// Every model the fixed-point path evaluates (the same list as the reference's).
 pub fn models() -> Vec<&'static str> {
