@@ -19,3 +19,4 @@ pub mod scene;
 pub mod selfcheck;
 pub mod sense;
 pub mod sim;
+pub mod station;

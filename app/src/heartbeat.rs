@@ -44,9 +44,10 @@ pub fn alive_count() -> u32 {
     ALIVE.load(Ordering::Relaxed)
 }
 
-/// The heartbeat task body. `on_wakeup` is called with the wake-up count after each wake-up
-/// (boards use it to inject failures in test builds); it may block.
-pub async fn heartbeat(mut on_wakeup: impl FnMut(u32)) -> ! {
+/// The heartbeat task body: runs for the self-check's [`REPORTS`] reports, then returns (the
+/// control loop is the sign of life after that). `on_wakeup` is called with the wake-up count
+/// after each wake-up (boards use it to inject failures in test builds); it may block.
+pub async fn heartbeat(mut on_wakeup: impl FnMut(u32)) {
     let period = Duration::from_hz(HEARTBEAT_HZ);
     let mut ticker = Ticker::every(period);
     let mut monitor = PeriodMonitor::new(
@@ -54,7 +55,7 @@ pub async fn heartbeat(mut on_wakeup: impl FnMut(u32)) -> ! {
         Duration::from_micros(MAX_LATE_US).as_ticks(),
     );
     let mut wakeups: u32 = 0;
-    loop {
+    while wakeups < WAKEUPS_PER_REPORT * REPORTS {
         ticker.next().await;
         monitor.record(Instant::now().as_ticks());
         wakeups = wakeups.saturating_add(1);

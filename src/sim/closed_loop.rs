@@ -19,16 +19,14 @@ use super::SimError;
 use super::commission::{COMMISSIONED, CellCalibration, commission};
 use super::judge::Judge;
 use super::quantity::{Judged, target_friction_n};
-use super::setup::{controller_settings, sensor_channel};
+use super::setup::controller_settings;
 use super::summary::{Observation, RunSummary};
-use crate::control::{
-    Config, Controller, Inputs, Output, Reason, Sensor, SensorFault, SensorFaultKind, Settings,
-};
-use crate::fx::{Q1_31, Q8_24, Q16_16};
-use crate::plant::{AnyModel, Plant, SensorReadings};
-use crate::protocol::{SupervisorState, Target};
+use crate::control::{Controller, ExternalFault, Output, Reason, SensorFault, Settings};
+use crate::fx::Q1_31;
+use crate::plant::{AnyModel, Gaussian, LoadCellSim, Plant, SensorReadings};
+use crate::protocol::{Axis, Command, ProtocolError, SupervisorState, Target};
 use crate::scene::{Breakpoint, Scene};
-use crate::sense::{SampleError, SensorChannel};
+use crate::station::{CellBench, Sample, Station};
 
 /// One control step of a run, for plots, CSV files and checks.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -73,17 +71,26 @@ enum Phase {
     Finish(SensorReadings, Output, Option<SensorFault>, bool),
 }
 
+/// Who gives the loop its targets and its start.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Mode {
+    /// The scene's script: its target profile, started at t = 0, judged, for its duration.
+    /// The loop's commands are refused (`wrong-state`): the script owns the loop.
+    Scripted,
+    /// An operator over the command protocol ([`ClosedLoop::execute`]): no target, idle at
+    /// t = 0, runs until stopped, not judged.
+    Operated,
+}
+
 /// A scene run in closed loop. No heap: about 9 KB, of which 4 KB hold the judge's step
 /// segments ([`super::MAX_SEGMENTS`]) and 2 KB the two models.
 #[derive(Debug, Clone)]
 pub struct ClosedLoop<'a> {
     scene: Scene<'a>,
     plant: Plant<'a, AnyModel>,
-    model: AnyModel,
-    controller: Controller,
-    normal: SensorChannel,
-    tangential: SensorChannel,
-    drive_hz: f32,
+    station: Station,
+    mode: Mode,
     command: f32,
     target_points: usize,
     phase: Phase,
@@ -104,36 +111,47 @@ impl<'a> ClosedLoop<'a> {
         settings: &Settings,
         calibration: CellCalibration,
     ) -> Result<Self, SimError> {
-        let plant = Plant::from_scene(scene).map_err(SimError::Plant)?;
-        let model = AnyModel::new(scene, &scene.controller).map_err(SimError::Model)?;
-        let mut controller = Controller::new(Config::new(settings).map_err(SimError::Config)?);
+        let mut run = Self::build(scene, settings, calibration, Mode::Scripted)?;
         if scene.target.iter().any(|point| !point.target.is_valid()) {
             return Err(SimError::InvalidTarget);
         }
         let first = scene.target.first().ok_or(SimError::InvalidTarget)?;
+        let controller = run.station.controller_mut();
         controller
             .set_target(first.target)
             .map_err(SimError::Control)?;
         controller.start().map_err(SimError::Control)?;
-        let mut normal = sensor_channel(&scene.normal_cell)?;
-        let mut tangential = sensor_channel(&scene.tangential_cell)?;
+        Ok(run)
+    }
+
+    /// The scene's plant under an operator's commands ([`Mode::Operated`]): commissioned
+    /// cells, the scene's controller settings, idle, no target.
+    pub fn operated(scene: &Scene<'a>) -> Result<Self, SimError> {
+        Self::build(
+            scene,
+            &controller_settings(scene),
+            COMMISSIONED,
+            Mode::Operated,
+        )
+    }
+
+    fn build(
+        scene: &Scene<'a>,
+        settings: &Settings,
+        calibration: CellCalibration,
+        mode: Mode,
+    ) -> Result<Self, SimError> {
+        let plant = Plant::from_scene(scene).map_err(SimError::Plant)?;
+        let mut station = Station::new(scene, settings)?;
         let seed = scene.noise_seed;
-        commission(&mut normal, &scene.normal_cell, calibration, seed, 0)?;
-        commission(
-            &mut tangential,
-            &scene.tangential_cell,
-            calibration,
-            seed,
-            1,
-        )?;
+        let (normal, tangential) = station.channels_mut();
+        commission(normal, &scene.normal_cell, calibration, seed, 0)?;
+        commission(tangential, &scene.tangential_cell, calibration, seed, 1)?;
         Ok(Self {
             scene: *scene,
             plant,
-            model,
-            controller,
-            normal,
-            tangential,
-            drive_hz: scene.transducer.drive_hz as f32,
+            station,
+            mode,
             command: 0.0,
             target_points: 1,
             phase: Phase::Plant,
@@ -142,18 +160,28 @@ impl<'a> ClosedLoop<'a> {
     }
 
     /// Whether the run has taken all of the scene's steps.
+    /// Always false in [`Mode::Operated`].
     pub fn is_finished(&self) -> bool {
-        matches!(self.phase, Phase::Plant) && self.plant.steps() >= self.scene.step_count()
+        self.mode == Mode::Scripted
+            && matches!(self.phase, Phase::Plant)
+            && self.plant.steps() >= self.scene.step_count()
     }
 
     /// Phase 1: the plant advances one period with the last command; returns what the
     /// converters read at its end. `None` when the run is finished or the period's other
     /// phases are still due.
     pub fn plant_phase(&mut self) -> Option<SensorReadings> {
+        self.plant_phase_driven(self.command)
+    }
+
+    /// Phase 1 with the drive amplitude the board's output holds (fraction of full scale,
+    /// [0, 1]) instead of the controller's last command: the firmware's plant reads its
+    /// drive output, so a drive forced safe (panic, fault) is what the plant sees.
+    pub fn plant_phase_driven(&mut self, drive_amplitude: f32) -> Option<SensorReadings> {
         if self.is_finished() || !matches!(self.phase, Phase::Plant) {
             return None;
         }
-        let readings = self.plant.step(self.command, self.drive_hz);
+        let readings = self.plant.step(drive_amplitude, self.station.drive_hz());
         self.phase = Phase::Control(readings);
         Some(readings)
     }
@@ -170,30 +198,22 @@ impl<'a> ClosedLoop<'a> {
         let target_step = points > self.target_points
             && self.scene.target.get(points - 1).is_some_and(|p| !p.ramp);
         self.target_points = points;
-        if let Some(target) = readings.truth.target
-            && self.controller.target() != Some(target)
+        if self.mode == Mode::Scripted
+            && let Some(target) = readings.truth.target
+            && self.station.controller().target() != Some(target)
         {
             // Every point was checked against the command's range at construction, and a ramp
             // interpolates between two of them: the command is accepted.
-            let _ = self.controller.set_target(target);
+            let _ = self.station.controller_mut().set_target(target);
         }
-        let (normal_force, normal_fault) =
-            sense(&mut self.normal, readings.normal_code, Sensor::NormalForce);
-        let (tangential_force, tangential_fault) = sense(
-            &mut self.tangential,
-            readings.tangential_code,
-            Sensor::TangentialForce,
-        );
-        let sensor_fault = normal_fault.or(tangential_fault);
-        let inputs = Inputs {
-            normal_force,
-            tangential_force,
-            sliding_velocity: Q8_24::from_f32_saturating(readings.sliding_velocity_m_per_s).value,
-            sensor_fault,
-        };
-        let output = self.controller.step(&inputs, &self.model);
+        let control = self.station.control(&Sample {
+            normal_code: readings.normal_code,
+            tangential_code: readings.tangential_code,
+            sliding_velocity_m_per_s: readings.sliding_velocity_m_per_s,
+        });
+        let output = control.output;
         self.command = output.amplitude.to_f32();
-        self.phase = Phase::Finish(readings, output, sensor_fault, target_step);
+        self.phase = Phase::Finish(readings, output, control.sensor_fault, target_step);
         Some(output)
     }
 
@@ -206,9 +226,9 @@ impl<'a> ClosedLoop<'a> {
         self.phase = Phase::Plant;
         let truth = &readings.truth;
         let judged = truth.target.map(|target| Judged::new(&target, truth));
-        let ceiling = self.controller.config().limit().max_amplitude;
+        let ceiling = self.station.controller().config().limit().max_amplitude;
         let at_limit = output.amplitude > Q1_31::ZERO && output.amplitude >= ceiling;
-        self.judge.observe(&Observation {
+        let observation = Observation {
             step: readings.step,
             time_s: truth.time_s,
             judged,
@@ -217,7 +237,10 @@ impl<'a> ClosedLoop<'a> {
             load_ramping: ramping(self.scene.normal_load_n, truth.time_s),
             state: output.state,
             drive_zero: output.amplitude == Q1_31::ZERO,
-        });
+        };
+        if self.mode == Mode::Scripted {
+            self.judge.observe(&observation);
+        }
         Some(StepRecord {
             step: readings.step,
             time_s: truth.time_s,
@@ -262,9 +285,42 @@ impl<'a> ClosedLoop<'a> {
         &self.scene
     }
 
+    /// Applies an operator's command to the loop between two periods ([`Station::execute`];
+    /// `tare` and `cal` read the scene's simulated cells under the load they name). Refused
+    /// as `wrong-state` in [`Mode::Scripted`].
+    pub fn execute(&mut self, command: &Command) -> Result<(), ProtocolError> {
+        if self.mode == Mode::Scripted {
+            return Err(ProtocolError::WrongState {
+                command: command.keyword(),
+                state: self.station.state(),
+            });
+        }
+        let mut bench = SimulatedCells {
+            scene: &self.scene,
+            burst: self.plant.steps(),
+        };
+        self.station.execute(command, &mut bench)
+    }
+
+    /// Latches an external fault (a control-loop overrun, an overcurrent trip) in the
+    /// controller: the next step drives zero. Accepted in either mode.
+    pub fn trip(&mut self, fault: ExternalFault) {
+        self.station.controller_mut().trip(fault);
+    }
+
+    /// Who gives the targets.
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// The control side (cells, controller, model, drive frequency).
+    pub fn station(&self) -> &Station {
+        &self.station
+    }
+
     /// The controller (its configuration and state).
     pub fn controller(&self) -> &Controller {
-        &self.controller
+        self.station.controller()
     }
 
     /// The plant.
@@ -273,20 +329,33 @@ impl<'a> ClosedLoop<'a> {
     }
 }
 
-/// One code through a channel: the force (zero on a fault) and the fault, as the controller
-/// names it. A code the converter cannot produce counts as out of range.
-fn sense(channel: &mut SensorChannel, code: u16, sensor: Sensor) -> (Q16_16, Option<SensorFault>) {
-    let kind = match channel.process(i32::from(code)) {
-        Ok(force) => return (force.value, None),
-        Err(SampleError::Fault(fault)) => match fault {
-            crate::sense::SensorFault::LowRail { .. }
-            | crate::sense::SensorFault::HighRail { .. } => SensorFaultKind::Disconnected,
-            crate::sense::SensorFault::Stuck { .. } => SensorFaultKind::Stuck,
-            crate::sense::SensorFault::Jump { .. } => SensorFaultKind::Jump,
-        },
-        Err(SampleError::Code(_)) => SensorFaultKind::OutOfRange,
-    };
-    (Q16_16::ZERO, Some(SensorFault { sensor, kind }))
+/// The scene's cells as a [`CellBench`]: settled on the load a command names, with their
+/// offset, gain error, noise and quantisation, and a noise generator of their own per burst
+/// (seeded from the scene and the plant's step count, so a run stays deterministic).
+struct SimulatedCells<'s, 'a> {
+    scene: &'s Scene<'a>,
+    burst: u32,
+}
+
+impl CellBench for SimulatedCells<'_, '_> {
+    fn burst(&mut self, axis: Axis, load_n: f32, codes: &mut [i32]) -> bool {
+        let (cell, index) = match axis {
+            Axis::Normal => (&self.scene.normal_cell, 2u64),
+            Axis::Tangential => (&self.scene.tangential_cell, 3u64),
+        };
+        let seed = self
+            .scene
+            .noise_seed
+            .wrapping_add(u64::from(self.burst).wrapping_mul(0x9E37_79B9_7F4A_7C15))
+            .wrapping_add(index);
+        let mut noise = Gaussian::from_seed(seed);
+        let mut sim = LoadCellSim::new(cell, 1e-4, load_n);
+        for code in codes.iter_mut() {
+            *code = i32::from(sim.sample(&mut noise, None));
+        }
+        self.burst = self.burst.wrapping_add(1);
+        true
+    }
 }
 
 /// Whether the piecewise-linear `profile` changes at `t_s` (between two breakpoints of

@@ -29,7 +29,7 @@ mod summary;
 #[cfg(test)]
 mod tests;
 
-pub use closed_loop::{ClosedLoop, StepRecord};
+pub use closed_loop::{ClosedLoop, Mode, StepRecord};
 pub use commission::{COMMISSIONED, COMMISSIONING_SAMPLES, CellCalibration, commission};
 pub use judge::{
     DEFAULT_BAND, DEFAULT_STEADY_AFTER_S, Judge, MAX_CRITERIA, MAX_FAULTS, MAX_SEGMENTS,

@@ -1,14 +1,16 @@
-//! The QEMU board's drive output.
+//! The QEMU board's drive output: what the simulated plant reads as its drive.
 //!
-//! On the real board the drive is a PWM power stage; here it is the amplitude command that the
-//! simulated plant reads. Until the plant is wired in, the output is a pair of atomics that the
-//! firmware writes and the safe-state hook clears: the hook and its call on panic, fault and exit
-//! are real, and the plant will read the same atomics.
+//! On the real board the drive is a PWM power stage; here it is an amplitude command in two
+//! atomics that the control task writes, the safe-state hook clears, and the simulated plant
+//! reads at the start of every period ([`crate::rig`]). So a drive forced safe by a panic, a
+//! watchdog NMI or a fault is exactly what the plant sees next.
 
-use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 
-/// Drive amplitude command as a fraction of full scale, in Q0.32 (0 = off).
-static AMPLITUDE: AtomicU32 = AtomicU32::new(0);
+use sonolube::fx::Q1_31;
+
+/// Drive amplitude command, Q1.31 fraction of full scale in [0, 1) (0 = off).
+static AMPLITUDE: AtomicI32 = AtomicI32::new(0);
 /// Whether the output stage is enabled.
 static ENABLED: AtomicBool = AtomicBool::new(false);
 
@@ -17,8 +19,8 @@ static ENABLED: AtomicBool = AtomicBool::new(false);
 pub struct DriveState {
     /// Output stage enabled.
     pub enabled: bool,
-    /// Amplitude command, Q0.32 of full scale.
-    pub amplitude_q32: u32,
+    /// Amplitude command, Q1.31 of full scale.
+    pub amplitude_q31: i32,
 }
 
 /// Puts the drive output in its safe state: stage disabled, amplitude zero. Callable from any
@@ -28,16 +30,28 @@ pub fn force_safe() {
     AMPLITUDE.store(0, Ordering::SeqCst);
 }
 
-/// Enables the output stage with an amplitude command in Q0.32 of full scale.
-pub fn set(amplitude_q32: u32) {
-    AMPLITUDE.store(amplitude_q32, Ordering::SeqCst);
-    ENABLED.store(amplitude_q32 != 0, Ordering::SeqCst);
+/// Sets the amplitude command (Q1.31, negative values count as zero); the stage is enabled
+/// while it is above zero.
+pub fn set(amplitude: Q1_31) {
+    let bits = amplitude.to_bits().max(0);
+    AMPLITUDE.store(bits, Ordering::SeqCst);
+    ENABLED.store(bits != 0, Ordering::SeqCst);
 }
 
 /// Current state of the drive output.
 pub fn state() -> DriveState {
     DriveState {
         enabled: ENABLED.load(Ordering::SeqCst),
-        amplitude_q32: AMPLITUDE.load(Ordering::SeqCst),
+        amplitude_q31: AMPLITUDE.load(Ordering::SeqCst),
+    }
+}
+
+/// The drive the plant sees: the amplitude as a fraction of full scale, zero while the stage
+/// is disabled.
+pub fn plant_input() -> f32 {
+    if ENABLED.load(Ordering::SeqCst) {
+        Q1_31::from_bits(AMPLITUDE.load(Ordering::SeqCst)).to_f32()
+    } else {
+        0.0
     }
 }

@@ -31,8 +31,9 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
     // The drive goes safe before anything else can go wrong (logging may itself fail).
     drive::force_safe();
     if !PANICKING.swap(true, Ordering::AcqRel) {
+        // `drive::state()` is the plant's input: the simulated plant reads its drive here.
         defmt::error!(
-            "drive output safe ({}); panic: {}",
+            "drive output safe, the plant's drive input is {}; panic: {}",
             drive::state(),
             defmt::Display2Format(info)
         );
@@ -47,12 +48,5 @@ unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
         "drive output safe; HardFault at pc {=u32:#010x}",
         frame.pc()
     );
-    semihosting::process::exit(FAULT)
-}
-
-#[cortex_m_rt::exception]
-unsafe fn DefaultHandler(irqn: i16) {
-    drive::force_safe();
-    defmt::error!("drive output safe; unexpected exception {=i16}", irqn);
     semihosting::process::exit(FAULT)
 }

@@ -1,33 +1,48 @@
 //! Sonolube firmware for QEMU's mps2-an386 (Cortex-M4F at 25 MHz): the simulated board.
 //!
-//! Boots, starts the SysTick time driver and a WFI executor, and runs the application's tasks
-//! (see `sonolube_app`). The run's verdict is the exit status of QEMU (see `exit.rs`).
+//! Boots, starts the SysTick time driver, the control executor (a software interrupt above
+//! everything else) and a WFI thread executor, and runs the application's tasks (see
+//! `sonolube_app`): the boot self-check, then the control loop on the simulated plant of a
+//! scene (`rig.rs`), the console on UART0 and the watchdog keeper. The run's verdict is the
+//! exit status of QEMU (see `exit.rs`).
 //!
-//! A watchdog keeper feeds the CMSDK watchdog only while the heartbeat advances; a stalled
-//! heartbeat gets an NMI (drive safe) and then a reset, and the next boot reports it.
+//! What runs is chosen by QEMU's `-append` words (`args.rs`): by default the `reference`
+//! scene's script, judged, then exit; `scene=NAME` another scene; `serve` the console drives
+//! the plant and the run goes on until QEMU is stopped.
 //!
-//! Test builds (cargo features) fail on purpose half-way through the run, so that the test
-//! command can check each failure is reported: `fail-selfcheck` stalls the heartbeat once (the
-//! self-check must fail), `hang` blocks the executor forever with the watchdog off (the runner's
-//! timeout must end the run), `watchdog-test` blocks it with the watchdog on (the watchdog must
-//! reset the machine and the next boot must report it), `panic-test` enables the drive and
-//! panics (the drive must be safe before the report).
+//! Test builds (cargo features) fail on purpose, so that the test command can check each
+//! failure is reported: `fail-selfcheck` stalls the heartbeat once (the self-check must fail),
+//! `hang` blocks the executor forever with the watchdog off (the runner's timeout must end the
+//! run), `watchdog-test` hangs the control task half-way through the scene with the watchdog
+//! on (the keeper must stop feeding, the watchdog reset the machine and the next boot report
+//! it), `panic-test` panics in the control task half-way through the scene (the drive, which
+//! is the plant's input, must be safe before the report).
 #![no_std]
 #![no_main]
 
+mod args;
 mod bench;
 mod drive;
 mod executor;
 mod exit;
-mod scene_run;
+mod irq;
+mod report;
+mod rig;
 mod time_driver;
+mod uart;
 mod watchdog;
 
 use defmt_semihosting as _;
-use embassy_executor::raw;
+use embassy_executor::{SendSpawner, raw};
 use embassy_time::{Duration, Instant};
-use sonolube_app::{Board, heartbeat};
+use sonolube::sim::Mode;
+use sonolube_app::console::Identity;
+use sonolube_app::control::Injection;
+use sonolube_app::{Board, console, control, heartbeat, supervisor};
 use static_cell::StaticCell;
+
+use crate::args::Args;
+use crate::rig::SimulatedRig;
 
 defmt::timestamp!("{=u64:us}", Instant::now().as_micros());
 
@@ -35,7 +50,7 @@ defmt::timestamp!("{=u64:us}", Instant::now().as_micros());
 struct Qemu;
 
 impl Board for Qemu {
-    const NAME: &'static str = "qemu mps2-an386";
+    const NAME: &'static str = "qemu-mps2-an386";
 
     fn drive_safe() {
         drive::force_safe();
@@ -50,8 +65,11 @@ impl Board for Qemu {
     }
 }
 
-/// In test builds, fails in the way the build's feature names, half-way through the run.
-fn inject_test_failure(wakeups: u32) {
+/// Most scenes the console lists.
+const MAX_SCENES: usize = 16;
+
+/// In test builds, fails the boot self-check in the way the build's feature names.
+fn inject_boot_failure(wakeups: u32) {
     const AT: u32 = heartbeat::WAKEUPS_PER_REPORT * heartbeat::REPORTS / 2;
     if wakeups != AT {
         return;
@@ -60,58 +78,127 @@ fn inject_test_failure(wakeups: u32) {
         defmt::warn!("test build: stalling the heartbeat for 3 ms");
         embassy_time::block_for(Duration::from_millis(3));
     }
-    if cfg!(feature = "panic-test") {
-        drive::set(u32::MAX / 4);
-        defmt::warn!("test build: drive {} and panicking", drive::state());
-        panic!("deliberate panic after {} heartbeats", wakeups);
-    }
-    if cfg!(any(feature = "hang", feature = "watchdog-test")) {
+    if cfg!(feature = "hang") {
         defmt::warn!("test build: blocking the executor forever");
         #[allow(clippy::empty_loop)]
         loop {}
     }
 }
 
-#[embassy_executor::task]
-async fn heartbeat_task() {
-    heartbeat::heartbeat(inject_test_failure).await
+/// In test builds, fails the control task half-way through the scene.
+fn inject_control_failure(step: u32, steps: u32) -> Injection {
+    if step != steps / 2 {
+        return Injection::None;
+    }
+    if cfg!(feature = "panic-test") {
+        defmt::warn!(
+            "test build: panicking in the control task, drive {}",
+            drive::state()
+        );
+        panic!("deliberate panic at control step {}", step);
+    }
+    if cfg!(feature = "watchdog-test") {
+        return Injection::Hang;
+    }
+    Injection::None
 }
 
-/// Watchdog timeout: an NMI after this long without progress of the heartbeat, a reset after
-/// twice this long.
-const WATCHDOG_TIMEOUT_MS: u32 = 20;
+#[embassy_executor::task]
+async fn heartbeat_task() {
+    heartbeat::heartbeat(inject_boot_failure).await
+}
+
+/// Watchdog timeout: an NMI after this long without a feed, a reset after twice this long.
+/// QEMU's watchdog counts virtual time, which includes the simulated plant's computation
+/// (left out of the firmware's clock: a period of the reference scene's Dahl plant costs about
+/// five periods of virtual time), so this is far longer than a real board's.
+const WATCHDOG_TIMEOUT_MS: u32 = 200;
+/// The keeper looks for signs of life this often (firmware time).
+const KEEPER_EVERY_MS: u64 = 5;
 
 #[embassy_executor::task]
-async fn watchdog_task() {
-    let mut last = heartbeat::alive_count();
-    loop {
-        embassy_time::Timer::after_millis(u64::from(WATCHDOG_TIMEOUT_MS / 4)).await;
-        let now = heartbeat::alive_count();
-        if now != last {
-            watchdog::feed();
-            last = now;
+async fn supervisor_task(args: Args, control_spawner: SendSpawner) {
+    if !heartbeat::self_check::<Qemu>().await {
+        exit::exit(exit::SELFCHECK_FAILED);
+    }
+    if cfg!(feature = "bench") {
+        Qemu::finish(bench::run());
+    }
+    let Some(scene) = sonolube::scene::builtin::find(args.scene) else {
+        defmt::error!("no scene named {=str}", args.scene);
+        exit::exit(exit::SELFCHECK_FAILED);
+    };
+    let mode = if args.serve {
+        Mode::Operated
+    } else {
+        Mode::Scripted
+    };
+    let rig = match time_driver::exclude(|| SimulatedRig::new(scene, mode)) {
+        Ok(rig) => rig,
+        Err(error) => {
+            defmt::error!("scene {=str} cannot run: {}", scene.name, error);
+            exit::exit(exit::SELFCHECK_FAILED);
+        }
+    };
+    match control_task(rig, args) {
+        Ok(token) => {
+            control_spawner.spawn(token);
+        }
+        Err(_) => {
+            defmt::error!("could not spawn the control task");
+            exit::exit(exit::FAULT);
         }
     }
 }
 
-/// The scene the firmware runs after its self-check.
-const DEFAULT_SCENE: &str = "reference";
+#[embassy_executor::task]
+async fn control_task(mut rig: SimulatedRig, args: Args) {
+    let scene = rig.scene();
+    if args.serve {
+        defmt::info!(
+            "serving the console on UART0: scene {=str} at {=f64} Hz, idle",
+            scene.name,
+            scene.control_rate_hz
+        );
+    } else {
+        defmt::info!(
+            "scene {=str}: {=u32} steps at {=f64} Hz",
+            scene.name,
+            scene.step_count(),
+            scene.control_rate_hz
+        );
+    }
+    let steps = scene.step_count();
+    let start = (
+        time_driver::cycles(),
+        executor::idle_cycles(),
+        time_driver::excluded_cycles(),
+    );
+    let stats = control::run(&mut rig, |step| inject_control_failure(step, steps)).await;
+    let elapsed = time_driver::cycles().saturating_sub(start.0);
+    let plant = time_driver::excluded_cycles().saturating_sub(start.2);
+    let idle = executor::idle_cycles().saturating_sub(start.1);
+    drive::force_safe();
+    report::cpu(
+        &stats,
+        elapsed.saturating_sub(idle),
+        elapsed,
+        args.icount_shift,
+    );
+    report::plant(&stats, plant, args.icount_shift);
+    let passed = report::verdicts(scene.name, &rig.summary());
+    Qemu::finish(passed)
+}
 
 #[embassy_executor::task]
-async fn supervisor_task() {
-    if !heartbeat::self_check::<Qemu>().await {
-        exit::exit(exit::SELFCHECK_FAILED);
-    }
-    let Some(scene) = sonolube::scene::builtin::find(DEFAULT_SCENE) else {
-        defmt::error!("no scene named {=str}", DEFAULT_SCENE);
-        exit::exit(exit::SELFCHECK_FAILED);
-    };
-    let passed = if cfg!(feature = "bench") {
-        bench::run()
-    } else {
-        scene_run::run(scene).await
-    };
-    Qemu::finish(passed)
+async fn console_task(rx: uart::UartRx, tx: uart::UartTx, identity: &'static Identity) {
+    console::serve(rx, tx, identity).await
+}
+
+/// Feeds the watchdog while the heartbeat (boot) or the control loop (after) advances.
+#[embassy_executor::task]
+async fn watchdog_task() {
+    supervisor::keeper(Duration::from_millis(KEEPER_EVERY_MS), watchdog::feed).await
 }
 
 #[cortex_m_rt::entry]
@@ -134,14 +221,45 @@ fn main() -> ! {
         Qemu::NAME,
         time_driver::CORE_CLOCK_HZ
     );
+    let args = match args::read() {
+        Ok(args) => args,
+        Err(reason) => {
+            defmt::error!("bad arguments: {=str}", reason);
+            exit::exit(exit::SELFCHECK_FAILED);
+        }
+    };
+    static SCENE_NAMES: StaticCell<heapless::Vec<&'static str, MAX_SCENES>> = StaticCell::new();
+    let names = SCENE_NAMES.init(
+        sonolube::scene::builtin::SCENES
+            .iter()
+            .map(|scene| scene.name)
+            .take(MAX_SCENES)
+            .collect(),
+    );
+    static IDENTITY: StaticCell<Identity> = StaticCell::new();
+    let identity = IDENTITY.init(Identity {
+        firmware: env!("CARGO_PKG_VERSION"),
+        board: Qemu::NAME,
+        scenes: names,
+    });
+    let (rx, tx) = uart::init();
+    let Some(control_spawner) = executor::start_control() else {
+        exit::exit(exit::FAULT);
+    };
 
     static EXECUTOR: StaticCell<raw::Executor> = StaticCell::new();
     let executor = EXECUTOR.init(raw::Executor::new(core::ptr::null_mut()));
     executor::run(executor, |spawner| {
-        match (heartbeat_task(), supervisor_task(), watchdog_task()) {
-            (Ok(heartbeat), Ok(supervisor), Ok(watchdog)) => {
+        match (
+            heartbeat_task(),
+            supervisor_task(args, control_spawner),
+            console_task(rx, tx, identity),
+            watchdog_task(),
+        ) {
+            (Ok(heartbeat), Ok(supervisor), Ok(console), Ok(watchdog)) => {
                 spawner.spawn(heartbeat);
                 spawner.spawn(supervisor);
+                spawner.spawn(console);
                 spawner.spawn(watchdog);
             }
             _ => {

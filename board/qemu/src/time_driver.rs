@@ -9,6 +9,10 @@
 //! Under `-icount shift=N` virtual time advances by 2^N ns per guest instruction, so the clock
 //! (and everything timed with it) is deterministic. With `sleep=off`, a WFI jumps virtual time
 //! straight to the next SysTick expiry.
+//!
+//! The firmware's clock leaves out the time spent in [`exclude`]: the simulated plant stands
+//! for hardware that runs beside the CPU, so its own computation must not use up the control
+//! period. `now = elapsed cycles - excluded cycles`.
 
 use core::cell::RefCell;
 use core::task::Waker;
@@ -44,6 +48,8 @@ struct Clock {
     alarm_at: u64,
     /// Largest time (cycles) handed out so far: `now` never goes backwards.
     last: u64,
+    /// Cycles spent inside [`exclude`], left out of the firmware's clock.
+    excluded: u64,
 }
 
 fn syst() -> &'static cortex_m::peripheral::syst::RegisterBlock {
@@ -68,15 +74,21 @@ fn counted(reload: u32, value: u32) -> u64 {
 }
 
 impl Clock {
-    fn now_cycles(&mut self) -> u64 {
+    /// Core cycles elapsed since boot, excluded time included.
+    fn elapsed_cycles(&self) -> u64 {
         let value = syst().cvr.read();
-        let cycles = if systick_pending() {
+        if systick_pending() {
             // The countdown ended but the interrupt has not run yet: count the whole countdown,
             // then what the restarted counter has counted since (read again after the wrap).
             self.base + u64::from(self.reload) + 1 + counted(self.reload, syst().cvr.read())
         } else {
             self.base + counted(self.reload, value)
-        };
+        }
+    }
+
+    /// The firmware's clock, in core cycles: elapsed minus excluded, never going backwards.
+    fn now_cycles(&mut self) -> u64 {
+        let cycles = self.elapsed_cycles().saturating_sub(self.excluded);
         self.last = self.last.max(cycles);
         self.last
     }
@@ -88,7 +100,7 @@ impl Clock {
     /// Starts a new countdown of `cycles` core cycles from now.
     fn arm(&mut self, cycles: u32) {
         let cycles = cycles.clamp(MIN_COUNTDOWN, MAX_COUNTDOWN);
-        let now = self.now_cycles();
+        let now = self.elapsed_cycles();
         // SAFETY: inside the caller's critical section; the ended countdown (if any) is already
         // counted in `now`, so its pending interrupt is dropped.
         unsafe {
@@ -179,7 +191,7 @@ impl Driver for SysTickDriver {
 }
 
 embassy_time_driver::time_driver_impl!(static DRIVER: SysTickDriver = SysTickDriver {
-    clock: Mutex::new(RefCell::new(Clock { base: 0, reload: MAX_COUNTDOWN - 1, alarm_at: u64::MAX, last: 0 })),
+    clock: Mutex::new(RefCell::new(Clock { base: 0, reload: MAX_COUNTDOWN - 1, alarm_at: u64::MAX, last: 0, excluded: 0 })),
     queue: Mutex::new(RefCell::new(Queue::new())),
 });
 
@@ -187,6 +199,33 @@ embassy_time_driver::time_driver_impl!(static DRIVER: SysTickDriver = SysTickDri
 /// that is 40 / 2^N guest instructions.
 pub fn cycles() -> u64 {
     critical_section::with(|cs| DRIVER.clock.borrow_ref_mut(cs).now_cycles())
+}
+
+/// Runs `work` with the firmware's clock stopped, interrupts masked: the time it takes is
+/// left out of `now`, of every timer and of [`cycles`]. For the simulated plant only. `work`
+/// must take less than one full countdown (2^24 cycles, 0.67 s of virtual time).
+pub fn exclude<R>(work: impl FnOnce() -> R) -> R {
+    critical_section::with(|cs| {
+        let start = {
+            let mut clock = DRIVER.clock.borrow_ref_mut(cs);
+            // No countdown may end twice while interrupts are masked: start the longest one.
+            clock.arm(MAX_COUNTDOWN);
+            clock.elapsed_cycles()
+        };
+        let result = work();
+        {
+            let mut clock = DRIVER.clock.borrow_ref_mut(cs);
+            let spent = clock.elapsed_cycles().saturating_sub(start);
+            clock.excluded += spent;
+        }
+        DRIVER.rearm(cs);
+        result
+    })
+}
+
+/// Core cycles spent inside [`exclude`] since boot.
+pub fn excluded_cycles() -> u64 {
+    critical_section::with(|cs| DRIVER.clock.borrow_ref(cs).excluded)
 }
 
 /// Starts SysTick as the time base. Call once, before the executor runs.

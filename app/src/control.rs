@@ -1,0 +1,150 @@
+//! The control task: one step per period on an `embassy_time::Ticker`, commands applied
+//! between steps, overruns counted, snapshot and telemetry published.
+//!
+//! # Overruns
+//!
+//! A step overruns when it ends after the next tick is due (the period's deadline). Each one
+//! is counted in [`link::OVERRUNS`] (reported by `status` and in every telemetry record) and
+//! the ticker is re-aligned to now, so missed ticks are skipped rather than run in a burst.
+//! [`OVERRUN_FAULT_RUN`] overruns in a row latch the controller's `overrun` fault: the drive
+//! goes to zero until `clear`.
+
+use embassy_time::{Duration, Instant, Ticker};
+use sonolube::protocol::{Command, ProtocolError};
+
+use crate::link::{self, LOST, OVERRUNS, REQUESTS, RESPONSES, SNAPSHOT, STEPS, TELEMETRY};
+use crate::snapshot::Snapshot;
+
+/// Overruns in a row that latch the `overrun` fault.
+pub const OVERRUN_FAULT_RUN: u32 = 3;
+
+/// A board's control loop: its sensing, the station (cells, controller, model) and its drive.
+pub trait ControlLoop {
+    /// Rate of the cycle clock in which [`Snapshot::control_cycles`] is counted, Hz.
+    const CYCLE_HZ: u64;
+    /// The control rate, Hz (the scene's); read again after every command.
+    fn rate_hz(&self) -> u32;
+    /// One period: read the sensors, run the control part, set the drive. `None` when the job
+    /// has ended (a scripted scene has taken its last step).
+    fn step(&mut self) -> Option<Snapshot>;
+    /// Applies a loop command between two steps, whole, or refuses it.
+    fn execute(&mut self, command: &Command) -> Result<(), ProtocolError>;
+    /// Latches the controller's overrun fault.
+    fn trip_overrun(&mut self);
+}
+
+/// What the loop measured over its run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, defmt::Format)]
+pub struct LoopStats {
+    /// Steps taken.
+    pub steps: u32,
+    /// Overrun steps.
+    pub overruns: u32,
+    /// Sum of the steps' control cycles.
+    pub control_cycles_total: u64,
+    /// Longest control part of a step, cycles.
+    pub control_cycles_max: u32,
+}
+
+impl LoopStats {
+    /// Mean control cycles per step, 0 before the first step.
+    pub fn control_cycles_mean(&self) -> u64 {
+        self.control_cycles_total
+            .checked_div(u64::from(self.steps))
+            .unwrap_or(0)
+    }
+}
+
+/// A test build's instruction to the loop after a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Injection {
+    /// Carry on.
+    None,
+    /// Stop stepping and never return (a hung control task, for the watchdog test).
+    Hang,
+}
+
+/// Runs `control` until its job ends; returns what it measured. `inject` is called with the
+/// step count after each step (test builds use it to fail on purpose).
+pub async fn run<L: ControlLoop>(
+    control: &mut L,
+    mut inject: impl FnMut(u32) -> Injection,
+) -> LoopStats {
+    let mut stats = LoopStats::default();
+    let mut rate_hz = control.rate_hz().max(1);
+    let mut period = Duration::from_hz(u64::from(rate_hz));
+    let mut ticker = Ticker::every(period);
+    let mut tick_at = Instant::now() + period;
+    let mut in_a_row = 0u32;
+    let mut seq = 0u32;
+    let mut since_record = 0u32;
+    loop {
+        ticker.next().await;
+        // Between two steps: at most one command per period.
+        if let Ok(command) = REQUESTS.try_receive() {
+            let result = control.execute(&command);
+            // The console waits for each answer before it sends the next request, so the
+            // depth-1 queue is empty here.
+            let _ = RESPONSES.try_send(result);
+            if control.rate_hz().max(1) != rate_hz {
+                rate_hz = control.rate_hz().max(1);
+                period = Duration::from_hz(u64::from(rate_hz));
+                ticker = Ticker::every(period);
+                tick_at = Instant::now() + period;
+                continue;
+            }
+        }
+        let Some(snapshot) = control.step() else {
+            return stats;
+        };
+        STEPS.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
+        stats.steps = stats.steps.saturating_add(1);
+        stats.control_cycles_total += u64::from(snapshot.control_cycles);
+        stats.control_cycles_max = stats.control_cycles_max.max(snapshot.control_cycles);
+        SNAPSHOT.lock(|cell| cell.set(snapshot));
+        if stats.steps == 1 {
+            // The loop runs: the console may answer from now on.
+            link::BOOTED.signal(());
+        }
+
+        let sample_at = tick_at;
+        let deadline = tick_at + period;
+        if Instant::now() >= deadline {
+            link::bump(&OVERRUNS);
+            stats.overruns = stats.overruns.saturating_add(1);
+            in_a_row += 1;
+            if in_a_row == OVERRUN_FAULT_RUN {
+                defmt::error!("{=u32} control overruns in a row: overrun fault", in_a_row);
+                control.trip_overrun();
+            }
+            ticker.reset();
+            tick_at = Instant::now() + period;
+        } else {
+            in_a_row = 0;
+            tick_at = deadline;
+        }
+
+        let telemetry_hz = link::count(&link::TELEMETRY_HZ);
+        if telemetry_hz > 0 {
+            since_record += 1;
+            if since_record >= (rate_hz / telemetry_hz).max(1) {
+                since_record = 0;
+                let record = snapshot.record(
+                    sample_at.as_micros(),
+                    seq,
+                    link::count(&OVERRUNS),
+                    link::count(&LOST),
+                );
+                seq = seq.wrapping_add(1);
+                if TELEMETRY.try_send(record).is_err() {
+                    link::bump(&LOST);
+                }
+            }
+        }
+
+        if inject(stats.steps) == Injection::Hang {
+            defmt::warn!("test build: the control task hangs");
+            core::future::pending::<()>().await;
+        }
+    }
+}

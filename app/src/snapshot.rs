@@ -1,0 +1,137 @@
+//! The loop's state after one step, in the protocol's integer units: what `status` and
+//! telemetry report.
+
+use sonolube::control::Output;
+use sonolube::fx::{Q1_31, Q2_30, Q16_16};
+use sonolube::protocol::{StatusReport, SupervisorState, Target, TelemetryRecord};
+
+/// The loop after a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, defmt::Format)]
+pub struct Snapshot {
+    /// Supervisor state.
+    pub state: SupervisorState,
+    /// The scene in use (a protocol word).
+    pub scene: Option<&'static str>,
+    /// Friction target, if set.
+    pub target: Option<Target>,
+    /// Friction coefficient estimate, ppm.
+    pub friction_coef_ppm: u32,
+    /// Filtered normal force, mN.
+    pub normal_force_mn: i32,
+    /// Filtered tangential force, mN.
+    pub tangential_force_mn: i32,
+    /// Drive amplitude command, ppm of full scale.
+    pub drive_amplitude_ppm: u32,
+    /// Drive frequency, cHz.
+    pub drive_freq_chz: u32,
+    /// The latched fault's name, if any.
+    pub latched_fault: Option<&'static str>,
+    /// A sensor fault found in this step's sample (its name), if any.
+    pub active_fault: Option<&'static str>,
+    /// Board cycles the step's control part took (sense, estimate, model, control, drive
+    /// command), in the board's cycle clock ([`crate::control::ControlLoop::CYCLE_HZ`]).
+    pub control_cycles: u32,
+}
+
+impl Snapshot {
+    /// The snapshot before the first step.
+    pub const BOOT: Snapshot = Snapshot {
+        state: SupervisorState::Boot,
+        scene: None,
+        target: None,
+        friction_coef_ppm: 0,
+        normal_force_mn: 0,
+        tangential_force_mn: 0,
+        drive_amplitude_ppm: 0,
+        drive_freq_chz: 0,
+        latched_fault: None,
+        active_fault: None,
+        control_cycles: 0,
+    };
+
+    /// The snapshot of a controller `output`, with the loop's other facts.
+    pub fn new(
+        output: &Output,
+        target: Option<Target>,
+        scene: &'static str,
+        drive_hz: f32,
+        active_fault: Option<&'static str>,
+        control_cycles: u32,
+    ) -> Self {
+        Snapshot {
+            state: output.state,
+            scene: Some(scene),
+            target,
+            friction_coef_ppm: coefficient_ppm(output.estimate.coefficient),
+            normal_force_mn: newtons_to_mn(output.estimate.normal_force),
+            tangential_force_mn: newtons_to_mn(output.estimate.tangential_force),
+            drive_amplitude_ppm: amplitude_ppm(output.amplitude),
+            drive_freq_chz: hz_to_chz(drive_hz),
+            latched_fault: output.fault.map(|reason| reason.name()),
+            active_fault,
+            control_cycles,
+        }
+    }
+
+    /// The `status` reply's data, with the loop's counters.
+    pub fn status(&self, overruns: u32, lost_telemetry: u32) -> StatusReport {
+        StatusReport {
+            state: self.state,
+            scene: self.scene,
+            target: self.target,
+            friction_coef_ppm: self.friction_coef_ppm,
+            normal_force_mn: self.normal_force_mn,
+            tangential_force_mn: self.tangential_force_mn,
+            drive_amplitude_ppm: self.drive_amplitude_ppm,
+            drive_freq_chz: self.drive_freq_chz,
+            overruns,
+            lost_telemetry,
+            latched_fault: self.latched_fault,
+        }
+    }
+
+    /// A telemetry record of this snapshot.
+    pub fn record(&self, time_us: u64, seq: u32, overruns: u32, lost: u32) -> TelemetryRecord {
+        TelemetryRecord {
+            time_us,
+            seq,
+            state: self.state,
+            target: self.target,
+            friction_coef_ppm: self.friction_coef_ppm,
+            normal_force_mn: self.normal_force_mn,
+            tangential_force_mn: self.tangential_force_mn,
+            drive_amplitude_ppm: self.drive_amplitude_ppm,
+            drive_freq_chz: self.drive_freq_chz,
+            overruns,
+            lost_records: lost,
+        }
+    }
+}
+
+/// Q2.30 coefficient [0, 2) to ppm, rounded: fits a u32.
+fn coefficient_ppm(coefficient: Q2_30) -> u32 {
+    let bits = i64::from(coefficient.to_bits().max(0));
+    u32::try_from((bits * 1_000_000 + (1 << 29)) >> 30).unwrap_or(u32::MAX)
+}
+
+/// Q16.16 newtons (+-32768 N) to mN, rounded: fits an i32.
+fn newtons_to_mn(force: Q16_16) -> i32 {
+    let bits = i64::from(force.to_bits());
+    i32::try_from((bits * 1_000 + (1 << 15)) >> 16).unwrap_or(i32::MAX)
+}
+
+/// Q1.31 amplitude [0, 1) to ppm, rounded.
+fn amplitude_ppm(amplitude: Q1_31) -> u32 {
+    let bits = i64::from(amplitude.to_bits().max(0));
+    u32::try_from((bits * 1_000_000 + (1 << 30)) >> 31).unwrap_or(u32::MAX)
+}
+
+/// Hz to cHz, rounded; 0 for a negative or non-finite value.
+fn hz_to_chz(hz: f32) -> u32 {
+    let chz = hz * 100.0 + 0.5;
+    if chz.is_finite() && chz >= 0.0 && chz < u32::MAX as f32 {
+        chz as u32
+    } else {
+        0
+    }
+}

@@ -1,0 +1,68 @@
+//! The run's arguments: QEMU's `-append` text, read over semihosting (SYS_GET_CMDLINE).
+//!
+//! `scripts/qemu-run ELF [WORD...]` passes the words after the ELF. Words:
+//! - `scene=NAME`: the scene (default [`DEFAULT_SCENE`]);
+//! - `serve`: operate the scene's plant from the console (the command interface on UART0) and
+//!   run until stopped, instead of playing the scene's script and exiting with its verdict;
+//! - `icount=N`: the `-icount shift` QEMU runs with (the runner adds it), so instruction
+//!   counts and the CPU load can be printed in instructions as well as in time.
+
+use core::mem::MaybeUninit;
+
+use static_cell::StaticCell;
+
+/// The scene run when none is named.
+pub const DEFAULT_SCENE: &str = "reference";
+
+/// The parsed arguments.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Args {
+    /// The scene's name (checked against the scenes later).
+    pub scene: &'static str,
+    /// Serve the console instead of playing the script.
+    pub serve: bool,
+    /// QEMU's `-icount shift`, if given.
+    pub icount_shift: Option<u8>,
+}
+
+/// Reads and parses the arguments; an unknown word is an error naming it.
+pub fn read() -> Result<Args, &'static str> {
+    static BUF: StaticCell<[MaybeUninit<u8>; 256]> = StaticCell::new();
+    let buf = BUF
+        .try_init([MaybeUninit::uninit(); 256])
+        .ok_or("arguments read twice")?;
+    let text: &'static str = match semihosting::sys::arm_compat::sys_get_cmdline_uninit(buf) {
+        Ok(bytes) => core::str::from_utf8(bytes).map_err(|_| "command line is not UTF-8")?,
+        // No command line: the defaults.
+        Err(_) => "",
+    };
+    parse(text)
+}
+
+fn parse(text: &'static str) -> Result<Args, &'static str> {
+    let mut args = Args {
+        scene: DEFAULT_SCENE,
+        serve: false,
+        icount_shift: None,
+    };
+    // The first word is the kernel's file name.
+    for word in text.split_ascii_whitespace().skip(1) {
+        if word == "serve" {
+            args.serve = true;
+        } else if let Some(name) = word.strip_prefix("scene=") {
+            args.scene = name;
+        } else if let Some(shift) = word.strip_prefix("icount=") {
+            args.icount_shift = Some(
+                shift
+                    .parse::<u8>()
+                    .ok()
+                    .filter(|s| *s <= 10)
+                    .ok_or("icount= takes a shift 0..=10")?,
+            );
+        } else {
+            defmt::error!("unknown argument {=str}", word);
+            return Err("unknown argument");
+        }
+    }
+    Ok(args)
+}

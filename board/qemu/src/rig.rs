@@ -1,0 +1,126 @@
+//! The QEMU board's control loop: the firmware's station on the simulated plant.
+//!
+//! Each period the plant advances with what the drive output holds ([`crate::drive`]) and
+//! gives its converter codes; the station (cells, controller, model) computes the next drive
+//! command, which goes to the drive output. The plant's computation, and the scene judge's,
+//! run inside [`time_driver::exclude`]: they stand for hardware and for the test bench, so
+//! they take none of the firmware's time. Only the control part is timed for the snapshot.
+//!
+//! This is [`sonolube::sim::ClosedLoop`], the same code as `sonolube scene` on the host, with
+//! the plant reading the board's drive output instead of the controller's command directly.
+
+use sonolube::control::ExternalFault;
+use sonolube::protocol::{Command, ProtocolError};
+use sonolube::scene::Scene;
+use sonolube::sim::{ClosedLoop, Mode, RunSummary, SimError};
+use sonolube_app::control::ControlLoop;
+use sonolube_app::snapshot::Snapshot;
+
+use crate::{drive, time_driver};
+
+/// The simulated rig running one scene.
+pub struct SimulatedRig {
+    scene: &'static Scene<'static>,
+    run: ClosedLoop<'static>,
+}
+
+impl SimulatedRig {
+    /// The rig of `scene`: playing its script ([`Mode::Scripted`]) or under the console
+    /// ([`Mode::Operated`]).
+    pub fn new(scene: &'static Scene<'static>, mode: Mode) -> Result<Self, SimError> {
+        let run = match mode {
+            Mode::Scripted => ClosedLoop::new(scene)?,
+            Mode::Operated => ClosedLoop::operated(scene)?,
+        };
+        Ok(Self { scene, run })
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &'static Scene<'static> {
+        self.scene
+    }
+
+    /// The judge's summary of the steps so far.
+    pub fn summary(&self) -> RunSummary {
+        time_driver::exclude(|| self.run.summary())
+    }
+
+    /// `scene NAME` under the console: a new rig with that scene's plant and station, when
+    /// the drive is off.
+    fn select_scene(&mut self, command: &Command, name: &str) -> Result<(), ProtocolError> {
+        use sonolube::protocol::SupervisorState::{Boot, Fault, Idle};
+        let state = self.run.controller().state();
+        if !matches!(state, Idle | Fault | Boot) {
+            return Err(ProtocolError::WrongState {
+                command: command.keyword(),
+                state,
+            });
+        }
+        let Some(scene) = sonolube::scene::builtin::find(name) else {
+            return Err(unknown_scene(command));
+        };
+        let run = time_driver::exclude(|| ClosedLoop::operated(scene));
+        match run {
+            Ok(run) => {
+                self.scene = scene;
+                self.run = run;
+                Ok(())
+            }
+            Err(error) => {
+                defmt::error!("scene {=str} cannot run: {}", name, error);
+                Err(unknown_scene(command))
+            }
+        }
+    }
+}
+
+fn unknown_scene(command: &Command) -> ProtocolError {
+    match *command {
+        Command::Scene(name) => ProtocolError::UnknownScene { name },
+        _ => ProtocolError::WrongState {
+            command: command.keyword(),
+            state: sonolube::protocol::SupervisorState::Idle,
+        },
+    }
+}
+
+impl ControlLoop for SimulatedRig {
+    const CYCLE_HZ: u64 = time_driver::CORE_CLOCK_HZ;
+
+    fn rate_hz(&self) -> u32 {
+        self.scene.control_rate_hz as u32
+    }
+
+    fn step(&mut self) -> Option<Snapshot> {
+        let drive_now = drive::plant_input();
+        time_driver::exclude(|| self.run.plant_phase_driven(drive_now))?;
+        let start = time_driver::cycles();
+        let output = self.run.control_phase()?;
+        drive::set(output.amplitude);
+        let cycles = time_driver::cycles().saturating_sub(start);
+        let record = time_driver::exclude(|| self.run.finish_step())?;
+        Some(Snapshot::new(
+            &output,
+            self.run.controller().target(),
+            self.scene.name,
+            self.run.station().drive_hz(),
+            record
+                .sensor_fault
+                .map(|fault| sonolube::control::Reason::SensorFault(fault).name()),
+            u32::try_from(cycles).unwrap_or(u32::MAX),
+        ))
+    }
+
+    fn execute(&mut self, command: &Command) -> Result<(), ProtocolError> {
+        match command {
+            Command::Scene(name) if self.run.mode() == Mode::Operated => {
+                self.select_scene(command, name.as_str())
+            }
+            _ => time_driver::exclude(|| self.run.execute(command)),
+        }
+    }
+
+    fn trip_overrun(&mut self) {
+        self.run.trip(ExternalFault::Overrun);
+    }
+}

@@ -1,0 +1,258 @@
+//! The firmware's control side of one scene, without the plant: the two load-cell channels, the
+//! controller and its friction model, the drive frequency, and the loop's share of the command
+//! protocol.
+//!
+//! A board feeds it the converter codes of each period ([`Station::control`]) and applies the
+//! returned drive amplitude; between two periods it hands it the commands that change the loop
+//! ([`Station::execute`]): a command is applied whole or refused with the protocol error, never
+//! half-applied. The scene closed loop of [`crate::sim`] is this station plus a simulated plant
+//! and a judge, so the host runs and the firmware runs share every line of the control path.
+//!
+//! `tare` and `cal` take a burst of samples from the cells through [`CellBench`]: a real board
+//! reads its converters (the operator has unloaded or loaded the cell), the simulated board
+//! reads its simulated cells under the load the command names.
+
+use crate::control::{
+    Config, Controller, Inputs, Output, Sensor, SensorFault, SensorFaultKind, Settings,
+};
+use crate::fx::{Q8_24, Q16_16};
+use crate::plant::AnyModel;
+use core::fmt::Write;
+
+use crate::protocol::DRIVE_FREQ;
+use crate::protocol::{Axis, Command, ProtocolError, SupervisorState, TareAxes, TokenText};
+use crate::scene::Scene;
+use crate::sense::{SampleError, SensorChannel};
+use crate::sim::{COMMISSIONING_SAMPLES, SimError, controller_settings, sensor_channel};
+
+/// What a board gives the station each period.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Sample {
+    /// Normal-force converter code (the cell's converter format, see [`crate::sense`]).
+    pub normal_code: u16,
+    /// Tangential-force converter code.
+    pub tangential_code: u16,
+    /// Sliding velocity, m/s, signed (measured, or the rig's set speed where it has no
+    /// sensor); saturated to the Q8.24 range +-128 m/s.
+    pub sliding_velocity_m_per_s: f32,
+}
+
+/// The result of one control period.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Control {
+    /// The controller's output; its `amplitude` is the drive command for the next period.
+    pub output: Output,
+    /// The fault the sensing chain found in this sample, if any.
+    pub sensor_fault: Option<SensorFault>,
+}
+
+/// Where `tare` and `cal` get their samples.
+pub trait CellBench {
+    /// Fills `codes` with consecutive converter codes of `axis`'s cell, which carries
+    /// `load_n` newtons (0 for `tare`; the known load for `cal`). A real board ignores
+    /// `load_n`: the operator has put that load on the cell. Returns false when the cell
+    /// could not be read.
+    fn burst(&mut self, axis: Axis, load_n: f32, codes: &mut [i32]) -> bool;
+}
+
+/// Lowest and highest drive frequency a `freq` command may set, cHz (the protocol's range).
+const FREQ_RANGE_CHZ: core::ops::RangeInclusive<u32> = 2_000_000..=6_000_000;
+
+/// The control side of a scene. About 3 KB (the cube model's tables are the bulk).
+#[derive(Debug, Clone)]
+pub struct Station {
+    model: AnyModel,
+    controller: Controller,
+    normal: SensorChannel,
+    tangential: SensorChannel,
+    drive_hz: f32,
+}
+
+impl Station {
+    /// The station of `scene`: its controller model, the controller with `settings`, the
+    /// cells with their datasheet calibration, the scene's drive frequency, idle, no target.
+    pub fn new(scene: &Scene<'_>, settings: &Settings) -> Result<Self, SimError> {
+        let model = AnyModel::new(scene, &scene.controller).map_err(SimError::Model)?;
+        let controller = Controller::new(Config::new(settings).map_err(SimError::Config)?);
+        Ok(Self {
+            model,
+            controller,
+            normal: sensor_channel(&scene.normal_cell)?,
+            tangential: sensor_channel(&scene.tangential_cell)?,
+            drive_hz: scene.transducer.drive_hz as f32,
+        })
+    }
+
+    /// [`Station::new`] with the scene's controller settings ([`controller_settings`]).
+    pub fn for_scene(scene: &Scene<'_>) -> Result<Self, SimError> {
+        Self::new(scene, &controller_settings(scene))
+    }
+
+    /// One control period: the codes through the sensing chain (format, fault checks,
+    /// calibration) to newtons, a fault found there as the controller's sensor fault, and the
+    /// controller step.
+    pub fn control(&mut self, sample: &Sample) -> Control {
+        let (normal_force, normal_fault) =
+            sense(&mut self.normal, sample.normal_code, Sensor::NormalForce);
+        let (tangential_force, tangential_fault) = sense(
+            &mut self.tangential,
+            sample.tangential_code,
+            Sensor::TangentialForce,
+        );
+        let sensor_fault = normal_fault.or(tangential_fault);
+        let inputs = Inputs {
+            normal_force,
+            tangential_force,
+            sliding_velocity: Q8_24::from_f32_saturating(sample.sliding_velocity_m_per_s).value,
+            sensor_fault,
+        };
+        let output = self.controller.step(&inputs, &self.model);
+        Control {
+            output,
+            sensor_fault,
+        }
+    }
+
+    /// Applies one of the loop's commands (`target`, `start`, `stop`, `clear`, `freq`, `tare`,
+    /// `cal`) whole, or refuses it with the protocol error and changes nothing. `tare` and
+    /// `cal` need the drive off (state `idle` or `fault`): a vibrating contact loads the cells.
+    /// Other commands are not the loop's: they are refused as `wrong-state`.
+    pub fn execute(
+        &mut self,
+        command: &Command,
+        bench: &mut impl CellBench,
+    ) -> Result<(), ProtocolError> {
+        let refused = |e: crate::control::ControlError| e.to_protocol();
+        match *command {
+            Command::Target(target) => self.controller.set_target(target).map_err(refused),
+            Command::Start => self.controller.start().map_err(refused),
+            Command::Stop => self.controller.stop().map_err(refused),
+            Command::Clear => self.controller.clear_fault().map_err(refused),
+            Command::Freq { freq_chz } => {
+                if !FREQ_RANGE_CHZ.contains(&freq_chz) {
+                    // The parser never produces one; a program that builds commands may.
+                    let mut token: heapless::String<16> = heapless::String::new();
+                    let _ = write!(token, "{}.{:02}", freq_chz / 100, freq_chz % 100);
+                    return Err(ProtocolError::OutOfRange {
+                        token: TokenText::new(token.as_str()),
+                        quantity: &DRIVE_FREQ,
+                    });
+                }
+                self.drive_hz = freq_chz as f32 / 100.0;
+                Ok(())
+            }
+            Command::Tare(axes) => {
+                self.require_drive_off(command)?;
+                let (normal, tangential) = match axes {
+                    TareAxes::One(Axis::Normal) => (true, false),
+                    TareAxes::One(Axis::Tangential) => (false, true),
+                    TareAxes::All => (true, true),
+                };
+                // Both bursts are taken before either channel changes: all or nothing.
+                let mut normal_codes = [0i32; COMMISSIONING_SAMPLES];
+                let mut tangential_codes = [0i32; COMMISSIONING_SAMPLES];
+                if normal && !bench.burst(Axis::Normal, 0.0, &mut normal_codes) {
+                    return Err(cal_failed("normal cell unreadable"));
+                }
+                if tangential && !bench.burst(Axis::Tangential, 0.0, &mut tangential_codes) {
+                    return Err(cal_failed("tangential cell unreadable"));
+                }
+                let mut new_normal = self.normal;
+                let mut new_tangential = self.tangential;
+                if normal {
+                    new_normal
+                        .tare(&normal_codes)
+                        .map_err(|_| cal_failed("normal zero unusable"))?;
+                }
+                if tangential {
+                    new_tangential
+                        .tare(&tangential_codes)
+                        .map_err(|_| cal_failed("tangential zero unusable"))?;
+                }
+                self.normal = new_normal;
+                self.tangential = new_tangential;
+                Ok(())
+            }
+            Command::Cal { axis, load_mn } => {
+                self.require_drive_off(command)?;
+                let load_n = load_mn as f64 / 1e3;
+                let load = Q16_16::from_f64(load_n)
+                    .map_err(|_| cal_failed("load beyond the Q16.16 span"))?;
+                let mut codes = [0i32; COMMISSIONING_SAMPLES];
+                if !bench.burst(axis, load_n as f32, &mut codes) {
+                    return Err(cal_failed("cell unreadable"));
+                }
+                let channel = match axis {
+                    Axis::Normal => &mut self.normal,
+                    Axis::Tangential => &mut self.tangential,
+                };
+                let mut updated = *channel;
+                updated
+                    .calibrate_gain(&codes, load)
+                    .map_err(|_| cal_failed("reading moved too little"))?;
+                *channel = updated;
+                Ok(())
+            }
+            _ => Err(ProtocolError::WrongState {
+                command: command.keyword(),
+                state: self.state(),
+            }),
+        }
+    }
+
+    fn require_drive_off(&self, command: &Command) -> Result<(), ProtocolError> {
+        match self.state() {
+            SupervisorState::Idle | SupervisorState::Fault | SupervisorState::Boot => Ok(()),
+            state => Err(ProtocolError::WrongState {
+                command: command.keyword(),
+                state,
+            }),
+        }
+    }
+
+    /// The supervisor's present state.
+    pub fn state(&self) -> SupervisorState {
+        self.controller.state()
+    }
+
+    /// The drive frequency, Hz.
+    pub fn drive_hz(&self) -> f32 {
+        self.drive_hz
+    }
+
+    /// The controller.
+    pub fn controller(&self) -> &Controller {
+        &self.controller
+    }
+
+    /// The controller, for the commands a scene script gives it and for trips.
+    pub fn controller_mut(&mut self) -> &mut Controller {
+        &mut self.controller
+    }
+
+    /// The two channels (normal, tangential), for commissioning.
+    pub fn channels_mut(&mut self) -> (&mut SensorChannel, &mut SensorChannel) {
+        (&mut self.normal, &mut self.tangential)
+    }
+}
+
+fn cal_failed(reason: &'static str) -> ProtocolError {
+    ProtocolError::CalFailed { reason }
+}
+
+/// One code through a channel: the force (zero on a fault) and the fault, as the controller
+/// names it. A code the converter cannot produce counts as out of range.
+fn sense(channel: &mut SensorChannel, code: u16, sensor: Sensor) -> (Q16_16, Option<SensorFault>) {
+    let kind = match channel.process(i32::from(code)) {
+        Ok(force) => return (force.value, None),
+        Err(SampleError::Fault(fault)) => match fault {
+            crate::sense::SensorFault::LowRail { .. }
+            | crate::sense::SensorFault::HighRail { .. } => SensorFaultKind::Disconnected,
+            crate::sense::SensorFault::Stuck { .. } => SensorFaultKind::Stuck,
+            crate::sense::SensorFault::Jump { .. } => SensorFaultKind::Jump,
+        },
+        Err(SampleError::Code(_)) => SensorFaultKind::OutOfRange,
+    };
+    (Q16_16::ZERO, Some(SensorFault { sensor, kind }))
+}
