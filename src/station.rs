@@ -256,3 +256,114 @@ fn sense(channel: &mut SensorChannel, code: u16, sensor: Sensor) -> (Q16_16, Opt
     };
     (Q16_16::ZERO, Some(SensorFault { sensor, kind }))
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::protocol::{Axis, Command, ErrorCode, SupervisorState, TareAxes, Target};
+    use crate::scene::find;
+    use crate::sim::{ClosedLoop, Mode};
+
+    fn operated() -> ClosedLoop<'static> {
+        ClosedLoop::operated(find("reference").expect("built in")).expect("runs")
+    }
+
+    fn code(result: Result<(), crate::protocol::ProtocolError>) -> Option<ErrorCode> {
+        result.err().map(|e| e.code())
+    }
+
+    #[test]
+    fn an_operated_loop_holds_the_commanded_coefficient_and_stops_on_command() {
+        let mut run = operated();
+        assert_eq!(run.mode(), Mode::Operated);
+        // Idle, no target: the drive stays off.
+        for _ in 0..20 {
+            let record = run.step().expect("never finishes");
+            assert_eq!(record.drive_amplitude, 0.0);
+        }
+        assert_eq!(
+            code(run.execute(&Command::Start)),
+            Some(ErrorCode::NoTarget)
+        );
+        let target = Target::Coef { coef_ppm: 150_000 };
+        assert_eq!(run.execute(&Command::Target(target)), Ok(()));
+        assert_eq!(run.execute(&Command::Start), Ok(()));
+        let mut last = None;
+        for _ in 0..200 {
+            last = run.step();
+        }
+        let record = last.expect("never finishes");
+        assert_eq!(record.state, SupervisorState::Running);
+        let mu = record.estimated_friction_n / record.normal_load_n;
+        assert!((mu - 0.15).abs() < 0.15 * 0.03, "mu {mu}");
+        assert_eq!(run.execute(&Command::Stop), Ok(()));
+        for _ in 0..200 {
+            last = run.step();
+        }
+        let record = last.expect("never finishes");
+        assert_eq!(record.drive_amplitude, 0.0);
+        assert_eq!(record.state, SupervisorState::Idle);
+    }
+
+    #[test]
+    fn a_scripted_loop_refuses_the_operators_commands_and_keeps_its_state() {
+        let mut run = ClosedLoop::new(find("reference").expect("built in")).expect("runs");
+        run.step().expect("first step");
+        let before = run.controller().target();
+        let refused = run.execute(&Command::Target(Target::Coef { coef_ppm: 100_000 }));
+        assert_eq!(code(refused), Some(ErrorCode::WrongState));
+        assert_eq!(
+            code(run.execute(&Command::Stop)),
+            Some(ErrorCode::WrongState)
+        );
+        assert_eq!(run.controller().target(), before);
+    }
+
+    #[test]
+    fn tare_and_cal_need_the_drive_off_and_change_nothing_when_refused() {
+        let mut run = operated();
+        assert_eq!(run.execute(&Command::Tare(TareAxes::All)), Ok(()));
+        let cal = Command::Cal {
+            axis: Axis::Normal,
+            load_mn: 5_000,
+        };
+        assert_eq!(run.execute(&cal), Ok(()));
+        run.execute(&Command::Target(Target::Reduction {
+            reduction_mpct: 30_000,
+        }))
+        .expect("target");
+        run.execute(&Command::Start).expect("start");
+        for _ in 0..50 {
+            run.step();
+        }
+        let state = run.controller().state();
+        assert_ne!(state, SupervisorState::Idle);
+        assert_eq!(
+            code(run.execute(&Command::Tare(TareAxes::One(Axis::Tangential)))),
+            Some(ErrorCode::WrongState)
+        );
+        assert_eq!(code(run.execute(&cal)), Some(ErrorCode::WrongState));
+    }
+
+    #[test]
+    fn a_drive_frequency_outside_the_range_is_refused_and_kept() {
+        let mut run = operated();
+        let before = run.station().drive_hz();
+        let refused = run.execute(&Command::Freq {
+            freq_chz: 6_000_001,
+        });
+        assert_eq!(code(refused), Some(ErrorCode::OutOfRange));
+        assert_eq!(run.station().drive_hz(), before);
+        assert_eq!(
+            run.execute(&Command::Freq {
+                freq_chz: 3_950_050
+            }),
+            Ok(())
+        );
+        assert_eq!(run.station().drive_hz(), 39_500.5);
+        // Not the loop's commands.
+        assert_eq!(
+            code(run.execute(&Command::Version)),
+            Some(ErrorCode::WrongState)
+        );
+    }
+}
