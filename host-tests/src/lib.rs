@@ -6,6 +6,7 @@
 
 pub mod cli;
 pub mod fixed_eval;
+pub mod monitor;
 pub mod papers;
 pub mod plot;
 pub mod reference;

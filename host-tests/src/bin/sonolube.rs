@@ -13,6 +13,11 @@ const SUBCOMMANDS: &[Subcommand] = &[
         sonolube_host::cli::eval::run,
     ),
     (
+        "monitor",
+        "talk to the firmware: commands, telemetry CSV/SVG, acceptance test",
+        sonolube_host::cli::monitor::run,
+    ),
+    (
         "papers",
         "paper numbers vs reference vs fixed point (markdown)",
         sonolube_host::cli::papers::run,

@@ -1,0 +1,364 @@
+//! `sonolube monitor`: talks to the firmware's command interface over its UART (QEMU's socket,
+//! TCP or a serial port): sends commands and prints their replies, records telemetry to CSV and
+//! SVG, and runs the acceptance test of the interface. The logic is in
+//! [`crate::monitor`]; this module reads the arguments and prints.
+//!
+//! ```text
+//! sonolube monitor --connect unix:/tmp/uart.sock -c "target coef 0.15" -c start -c "wait 50"
+//! sonolube monitor --connect serial:/dev/ttyACM0 --script session.txt --csv run.csv --svg run.svg
+//! sonolube monitor --connect unix:/tmp/uart.sock --acceptance --csv target/monitor/acceptance.csv
+//! ```
+//!
+//! Exit status: 0 when every reply was `ok` (and the acceptance test passed, when asked); 1 when
+//! a command got an `err` reply (unless `--allow-errors`), a check failed, the connection was
+//! lost or timed out, the firmware sent malformed lines, or an output file could not be
+//! written; 2 for a usage error.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Duration;
+
+use crate::monitor::{
+    AcceptanceConfig, Endpoint, Link, LinkOptions, Session, Step, parse_script, parse_step,
+    run_acceptance, run_steps, telemetry_csv, telemetry_svg,
+};
+
+const USAGE: &str = "\
+usage: sonolube monitor --connect ENDPOINT [-c CMD]... [--script FILE]... [--acceptance]
+                        [--csv FILE] [--svg FILE] [--allow-errors] [options]
+
+Sends each command to the firmware, waits for its reply and prints both ('> command',
+'< reply'); records the telemetry; optionally runs the acceptance test of the command
+interface after the commands.
+
+  --connect ENDPOINT       unix:PATH       Unix socket (QEMU -chardev socket), retried until
+                                           it accepts or --connect-timeout-ms passes
+                           tcp:HOST:PORT   TCP connection, retried the same way
+                           serial:DEV[@BAUD]  serial port, 8N1, default 115200 baud
+  -c, --command CMD        send CMD (repeatable; -c and --script run in the order given)
+  --script FILE            send FILE's lines: one command per line, blank lines and lines
+                           starting with '#' skipped, and 'wait MS': MS ms of firmware time
+                           (telemetry t_us) while telemetry is on, of wall time while it is off
+  --acceptance             run the acceptance test (6 checks, 'monitor acceptance: N passed,
+                           M failed'); exit 1 unless all pass
+  --csv FILE               write every telemetry record: header row, one column per field
+  --svg FILE               plot the telemetry: friction target and estimate, drive amplitude,
+                           forces
+  --allow-errors           exit 0 even when a command got an err reply
+  --timeout-ms MS          longest wait for a reply, and longest telemetry silence while
+                           waiting on it (default 5000)
+  --connect-timeout-ms MS  how long to retry connecting to a socket (default 10000)
+  --seed N                 seed of the acceptance flood (decimal or 0x hex; default 0x50a01be5)
+  --flood-lines N          malformed lines in the acceptance flood (default 10000)
+  --window N               flood lines sent ahead of their replies (default 4)
+  --telemetry-hz N         telemetry rate of the acceptance test (default 1000; lower it on a
+                           115200-baud serial port, the observation lengthens to match)
+
+exit status: 0 all ok; 1 an err reply, a failed check, a lost or silent connection, malformed
+lines from the firmware, or an unwritable output file; 2 a usage error
+";
+
+/// The parsed command line.
+struct Options {
+    endpoint: Endpoint,
+    steps: Vec<Step>,
+    acceptance: bool,
+    csv: Option<PathBuf>,
+    svg: Option<PathBuf>,
+    allow_errors: bool,
+    link: LinkOptions,
+    config: AcceptanceConfig,
+}
+
+/// Entry point: `args` are the arguments after `monitor`.
+pub fn run(args: &[String]) -> ExitCode {
+    let options = match parse_args(args) {
+        Ok(Some(options)) => options,
+        Ok(None) => {
+            print!("{USAGE}");
+            return ExitCode::SUCCESS;
+        }
+        Err(problem) => {
+            eprint!("sonolube monitor: {problem}\n\n{USAGE}");
+            return ExitCode::from(2);
+        }
+    };
+    if options.steps.is_empty() && !options.acceptance {
+        eprint!("sonolube monitor: nothing to do: give -c, --script or --acceptance\n\n{USAGE}");
+        return ExitCode::from(2);
+    }
+    let mut link = match Link::connect(&options.endpoint, options.link) {
+        Ok(link) => link,
+        Err(error) => {
+            eprintln!("sonolube monitor: {error}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let mut failed = false;
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    let _ = writeln!(out, "# connected to {}", options.endpoint);
+    let mut connected = true;
+    match run_steps(&mut link, &options.steps, &mut out) {
+        Ok(outcome) => {
+            if outcome.errors + outcome.malformed > 0 {
+                let _ = writeln!(
+                    out,
+                    "# {} of {} commands got an err reply, {} a malformed reply{}",
+                    outcome.errors,
+                    outcome.commands,
+                    outcome.malformed,
+                    if options.allow_errors {
+                        " (allowed)"
+                    } else {
+                        ""
+                    }
+                );
+                failed |= !options.allow_errors || outcome.malformed > 0;
+            }
+        }
+        Err(error) => {
+            eprintln!("sonolube monitor: {error}");
+            failed = true;
+            connected = false;
+        }
+    }
+    if options.acceptance {
+        if connected {
+            let _ = writeln!(
+                out,
+                "# acceptance test on {} (flood seed {:#x}, {} lines)",
+                options.endpoint, options.config.seed, options.config.flood_lines
+            );
+            let report = run_acceptance(&mut link, &options.config, &mut out);
+            let _ = writeln!(out, "{}", report.summary());
+            failed |= !report.all_passed();
+        } else {
+            let _ = writeln!(out, "monitor acceptance: not run, the connection failed");
+        }
+    }
+    let session = link.finish();
+    failed |= !summarize(&session, &mut out);
+    let band = options.acceptance.then_some(options.config.tolerance_pct);
+    let title = format!(
+        "sonolube monitor {}: {} telemetry records",
+        options.endpoint,
+        session.telemetry.received()
+    );
+    let records = session.telemetry.records();
+    if let Some(path) = &options.csv {
+        failed |= !write(&mut out, path, &telemetry_csv(records));
+    }
+    if let Some(path) = &options.svg {
+        failed |= !write(&mut out, path, &telemetry_svg(&title, records, band));
+    }
+    let _ = out.flush();
+    if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// Prints what was received; false when the firmware broke the protocol.
+fn summarize(session: &Session, out: &mut dyn Write) -> bool {
+    let log = &session.telemetry;
+    let gaps = log.gaps();
+    let _ = writeln!(
+        out,
+        "# received {} lines: {} telemetry records ({} kept), seq gaps {} ({} records missing, \
+         {} accounted by lost, {} unexplained, {} restarts)",
+        session.lines,
+        log.received(),
+        log.records().len(),
+        gaps.gaps,
+        gaps.missing,
+        gaps.explained,
+        gaps.unexplained,
+        gaps.restarts
+    );
+    let anomalies = &session.anomalies;
+    if let Some(partial) = &anomalies.partial_first_line {
+        let _ = writeln!(out, "# first line discarded as partial: {partial:?}");
+    }
+    if anomalies.is_clean() {
+        return true;
+    }
+    eprintln!(
+        "sonolube monitor: the firmware sent {} malformed lines and {} replies without a command",
+        anomalies.malformed, anomalies.unsolicited
+    );
+    for example in &anomalies.examples {
+        eprintln!("  {example}");
+    }
+    false
+}
+
+fn write(out: &mut dyn Write, path: &Path, text: &str) -> bool {
+    let result = match path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        Some(dir) => std::fs::create_dir_all(dir),
+        None => Ok(()),
+    }
+    .and_then(|()| std::fs::write(path, text));
+    match result {
+        Ok(()) => {
+            let _ = writeln!(out, "# wrote {}", path.display());
+            true
+        }
+        Err(error) => {
+            eprintln!("sonolube monitor: {}: {error}", path.display());
+            false
+        }
+    }
+}
+
+fn number<T: std::str::FromStr>(flag: &str, text: &str) -> Result<T, String> {
+    text.parse()
+        .map_err(|_| format!("{flag} {text}: not a valid number"))
+}
+
+fn seed(text: &str) -> Result<u64, String> {
+    let parsed = match text.strip_prefix("0x").or_else(|| text.strip_prefix("0X")) {
+        Some(hex) => u64::from_str_radix(hex, 16),
+        None => text.parse(),
+    };
+    parsed.map_err(|_| format!("--seed {text}: not a decimal or 0x hex number"))
+}
+
+/// `Ok(None)` for `--help`.
+fn parse_args(args: &[String]) -> Result<Option<Options>, String> {
+    let mut endpoint = None;
+    let mut steps = Vec::new();
+    let mut acceptance = false;
+    let mut csv = None;
+    let mut svg = None;
+    let mut allow_errors = false;
+    let mut link = LinkOptions::default();
+    let mut config = AcceptanceConfig::default();
+    let mut rest = args.iter();
+    while let Some(flag) = rest.next() {
+        let flag = flag.as_str();
+        match flag {
+            "-h" | "--help" => return Ok(None),
+            "--acceptance" => acceptance = true,
+            "--allow-errors" => allow_errors = true,
+            "--connect"
+            | "-c"
+            | "--command"
+            | "--script"
+            | "--csv"
+            | "--svg"
+            | "--timeout-ms"
+            | "--connect-timeout-ms"
+            | "--seed"
+            | "--flood-lines"
+            | "--window"
+            | "--telemetry-hz" => {
+                let value = rest
+                    .next()
+                    .ok_or_else(|| format!("{flag} needs a value"))?
+                    .as_str();
+                match flag {
+                    "--connect" => endpoint = Some(Endpoint::parse(value)?),
+                    "-c" | "--command" => match parse_step(value) {
+                        Ok(Some(step)) => steps.push(step),
+                        Ok(None) => return Err(format!("{flag} {value:?}: no command")),
+                        Err(why) => return Err(format!("{flag}: {why}")),
+                    },
+                    "--script" => {
+                        let text = std::fs::read_to_string(value)
+                            .map_err(|e| format!("--script {value}: {e}"))?;
+                        steps.extend(parse_script(&text).map_err(|e| format!("{value}: {e}"))?);
+                    }
+                    "--csv" => csv = Some(PathBuf::from(value)),
+                    "--svg" => svg = Some(PathBuf::from(value)),
+                    "--timeout-ms" => {
+                        link.reply_timeout =
+                            Duration::from_millis(number::<u64>(flag, value)?.max(1));
+                    }
+                    "--connect-timeout-ms" => {
+                        link.connect_timeout = Duration::from_millis(number(flag, value)?);
+                    }
+                    "--seed" => config.seed = seed(value)?,
+                    "--flood-lines" => config.flood_lines = number(flag, value)?,
+                    "--telemetry-hz" => {
+                        config.telemetry_hz = number::<u16>(flag, value)
+                            .ok()
+                            .filter(|hz| (1..=10_000).contains(hz))
+                            .ok_or_else(|| format!("{flag} {value}: not 1..=10000"))?;
+                    }
+                    _ => config.window = number::<usize>(flag, value)?.max(1),
+                }
+            }
+            other => return Err(format!("unexpected argument {other:?}")),
+        }
+    }
+    let endpoint = endpoint.ok_or("--connect ENDPOINT is required")?;
+    Ok(Some(Options {
+        endpoint,
+        steps,
+        acceptance,
+        csv,
+        svg,
+        allow_errors,
+        link,
+        config,
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(list: &[&str]) -> Vec<String> {
+        list.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn arguments_in_order() {
+        let options = parse_args(&args(&[
+            "--connect",
+            "unix:/tmp/x.sock",
+            "-c",
+            "status",
+            "--command",
+            "wait 5",
+            "--acceptance",
+            "--seed",
+            "0x10",
+            "--window",
+            "0",
+            "--timeout-ms",
+            "250",
+        ]))
+        .unwrap()
+        .unwrap();
+        assert_eq!(options.endpoint, Endpoint::Unix("/tmp/x.sock".into()));
+        assert_eq!(
+            options.steps,
+            [Step::Command("status".into()), Step::Wait(5)]
+        );
+        assert!(options.acceptance && !options.allow_errors);
+        assert_eq!((options.config.seed, options.config.window), (16, 1));
+        assert_eq!(options.link.reply_timeout, Duration::from_millis(250));
+    }
+
+    #[test]
+    fn usage_errors() {
+        assert!(parse_args(&args(&["--help"])).unwrap().is_none());
+        for bad in [
+            &["-c", "status"][..],
+            &["--connect"],
+            &["--connect", "com1"],
+            &["--connect", "unix:/x", "-c", " "],
+            &["--connect", "unix:/x", "-c", "wait"],
+            &["--connect", "unix:/x", "--seed", "0xzz"],
+            &["--connect", "unix:/x", "--script", "/nonexistent/script"],
+            &["--connect", "unix:/x", "extra"],
+            &["--connect", "unix:/x", "--telemetry-hz", "0"],
+        ] {
+            assert!(parse_args(&args(bad)).is_err(), "{bad:?}");
+        }
+    }
+}
