@@ -80,6 +80,7 @@ pub async fn run<L: ControlLoop>(
     let mut since_record = 0u32;
     loop {
         ticker.next().await;
+        let woke = Instant::now();
         // Between two steps: at most one command per period.
         if let Ok(command) = REQUESTS.try_receive() {
             let result = control.execute(&command);
@@ -110,6 +111,12 @@ pub async fn run<L: ControlLoop>(
         let sample_at = tick_at;
         let deadline = tick_at + period;
         if Instant::now() >= deadline {
+            defmt::warn!(
+                "control overrun: woke {=u64} us after its tick, step ended {=u64} us after the deadline, control part {=u32} cycles",
+                (woke - tick_at.min(woke)).as_micros(),
+                (Instant::now() - deadline).as_micros(),
+                snapshot.control_cycles
+            );
             link::bump(&OVERRUNS);
             stats.overruns = stats.overruns.saturating_add(1);
             in_a_row += 1;
