@@ -131,10 +131,11 @@ pub async fn run<L: ControlLoop>(
             tick_at = deadline;
         }
 
-        let telemetry_hz = link::count(&link::TELEMETRY_HZ);
-        if telemetry_hz > 0 {
+        // Steps per record: the rate rounded down to whole steps, at most one per step; none
+        // while telemetry is off (rate 0).
+        if let Some(every) = rate_hz.checked_div(link::count(&link::TELEMETRY_HZ)) {
             since_record += 1;
-            if since_record >= (rate_hz / telemetry_hz).max(1) {
+            if since_record >= every.max(1) {
                 since_record = 0;
                 let record = snapshot.record(
                     sample_at.as_micros(),
