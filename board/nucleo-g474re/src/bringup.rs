@@ -13,7 +13,8 @@ use sonolube::drive::{Amplitude, AmplitudeRamp, DriveLimits, DriveTiming};
 
 use crate::{config, drive, safe};
 
-/// The hold-to-run state, polled by the sensing loop (once per DMA half-buffer, 38 ms at 40 kHz).
+/// The hold-to-run state, polled by the sensing loop every [`crate::sense_task::HOLD_POLL_TRIPLETS`]
+/// ADC triplets (38 ms at 40 kHz).
 pub struct HoldToRun {
     button: Input<'static>,
     timing: DriveTiming,

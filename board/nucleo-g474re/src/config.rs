@@ -44,8 +44,8 @@ pub const BRINGUP_AMPLITUDE: Amplitude = match Amplitude::from_ratio(1, 4) {
 };
 
 #[cfg(feature = "bringup")]
-/// Soft start and stop of the bring-up drive, in steps of the sensing loop (one per DMA
-/// half-buffer, 38 ms at 40 kHz): 0 to full scale in 10 steps (0.4 s), back in 5.
+/// Soft start and stop of the bring-up drive, in polls of the hold-to-run (one per 32 ADC
+/// triplets, 38 ms at 40 kHz): 0 to full scale in 10 steps (0.4 s), back in 5.
 pub const RAMP_RISE_STEPS: u32 = 10;
 /// See [`RAMP_RISE_STEPS`].
 #[cfg(feature = "bringup")]

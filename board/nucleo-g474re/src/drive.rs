@@ -6,8 +6,11 @@
 //! TRGO2 from OC4REF for the ADC. Register layout and sequences: RM0440, advanced-control
 //! timers (TIM1/TIM8/TIM20).
 //!
-//! Outputs stay off (BDTR.MOE = 0) after [`Drive::new`]; only [`try_enable_outputs`] sets MOE,
-//! and only the bring-up build calls it.
+//! Outputs stay off (BDTR.MOE = 0) after [`Drive::new`]; only [`try_enable_outputs`] sets MOE:
+//! the control loop's [`crate::bridge`] in the normal build, the hold-to-run button in the
+//! bring-up build.
+
+use core::sync::atomic::{AtomicBool, Ordering};
 
 use embassy_stm32::Peri;
 use embassy_stm32::gpio::OutputType;
@@ -134,8 +137,7 @@ pub fn set_amplitude(timing: &DriveTiming, amplitude: Amplitude) {
 }
 
 /// Sets MOE: the bridge switches. Refused (returns false) while the break input is active or a
-/// break has not been acknowledged with [`clear_break_flag`]. Bring-up build only.
-#[cfg(feature = "bringup")]
+/// break has not been acknowledged with [`clear_break_flag`].
 pub fn try_enable_outputs() -> bool {
     if break_tripped() {
         return false;
@@ -159,4 +161,19 @@ pub fn clear_break_flag() {
 /// Whether the outputs are enabled (MOE).
 pub fn outputs_enabled() -> bool {
     pac::TIM1.bdtr().read().moe()
+}
+
+/// Whether the latest current-sense sample was healthy (no rail, a valid code). False until
+/// sensing runs. The control loop switches the bridge on only while it is true: the current
+/// sense is the safety channel, and its faulty samples make the sensing task clear MOE.
+static CURRENT_SENSE_HEALTHY: AtomicBool = AtomicBool::new(false);
+
+/// Records the health of the latest current-sense sample (sensing task).
+pub fn set_current_sense_healthy(healthy: bool) {
+    CURRENT_SENSE_HEALTHY.store(healthy, Ordering::Relaxed);
+}
+
+/// Whether the latest current-sense sample was healthy.
+pub fn current_sense_healthy() -> bool {
+    CURRENT_SENSE_HEALTHY.load(Ordering::Relaxed)
 }

@@ -1,5 +1,6 @@
 //! The drive-and-sense task: after the self-check, configure the drive (outputs off), arm the
-//! overcurrent trip, tare the current sense, then sample the sensors and log them at 2 Hz.
+//! overcurrent trip, tare the current sense, then sample the sensors, hand every load-cell
+//! pair to the control loop ([`crate::cells`]) and log them at 2 Hz.
 
 use embassy_stm32::Peri;
 use embassy_stm32::peripherals::{ADC1, COMP1, DAC3, DMA1_CH1, PA0, PA1, PA8, PB0, PB13, TIM1};
@@ -7,6 +8,7 @@ use embassy_time::{Duration, Instant};
 use sonolube::drive::{Amplitude, DriveLimits, DriveTiming, OvercurrentTrip};
 use sonolube::sense::{Calibration, SampleError, SensorChannel};
 
+use crate::cells::{self, RawPair};
 use crate::overcurrent::OvercurrentGuard;
 use crate::sensing::{self, Block, CHANNELS, ChannelLog, TRIPLETS_PER_READ};
 use crate::{SELF_CHECK_PASSED, SENSING_STARTED, config, drive, safe};
@@ -40,6 +42,15 @@ pub struct Hardware {
 
 /// Interval between sensor log lines.
 const LOG_PERIOD: Duration = Duration::from_millis(500);
+
+/// Triplets whose current samples, taken with the drive off, are the current sense's zero
+/// (38 ms at 40 kHz).
+const TARE_TRIPLETS: usize = 32;
+
+/// The bring-up hold-to-run is polled every this many triplets (38 ms at 40 kHz), the cadence
+/// its ramp was set for ([`config::RAMP_RISE_STEPS`]).
+#[cfg(feature = "bringup")]
+pub const HOLD_POLL_TRIPLETS: u32 = 32;
 
 /// The task body. Never returns; on a configuration error it logs and parks with the outputs
 /// off.
@@ -88,11 +99,22 @@ pub async fn run(mut hw: Hardware) {
         timing.quiet_window_ns()
     );
 
-    // The first block, with the drive off, is the current sense's zero.
+    // The first triplets, with the drive off, are the current sense's zero (an overrun only
+    // loses samples).
     let mut block: Block = [0; CHANNELS * TRIPLETS_PER_READ];
-    if ring.read(&mut block).await.is_ok() {
-        tare_current(&mut channels[2], &block, &nominal_current, &mut guard);
+    let mut zero_codes = [0i32; TARE_TRIPLETS];
+    let mut taken = 0;
+    while taken < TARE_TRIPLETS {
+        if ring.read(&mut block).await.is_ok() {
+            for triplet in block.chunks_exact(CHANNELS) {
+                if let (Some(slot), [_, _, current]) = (zero_codes.get_mut(taken), triplet) {
+                    *slot = i32::from(*current);
+                    taken += 1;
+                }
+            }
+        }
     }
+    tare_current(&mut channels[2], &zero_codes, &nominal_current, &mut guard);
     // Ignore whatever faults the tare block would have shown: start the history afresh.
     for channel in &mut channels {
         channel.reset_faults();
@@ -102,6 +124,8 @@ pub async fn run(mut hw: Hardware) {
 
     #[cfg(feature = "bringup")]
     let mut hold = crate::bringup::HoldToRun::new(hw.button, timing);
+    #[cfg(feature = "bringup")]
+    let mut since_poll: u32 = 0;
     let mut logs = [ChannelLog::new(), ChannelLog::new(), ChannelLog::new()];
     let mut overruns: u32 = 0;
     let mut next_log = Instant::now() + LOG_PERIOD;
@@ -111,18 +135,31 @@ pub async fn run(mut hw: Hardware) {
                 for triplet in block.chunks_exact(CHANNELS) {
                     for (i, &code) in triplet.iter().enumerate() {
                         let fault = logs[i].record(&mut channels[i], i32::from(code));
-                        // A saturated or disconnected current sense stops the drive at once;
-                        // load-cell faults are the control loop's business (logged here).
-                        if i == 2 && fault.is_some() {
-                            safe::drive_safe();
+                        // A saturated or disconnected current sense stops the drive at once and
+                        // keeps the control loop from switching it on; load-cell faults are the
+                        // control loop's business (its station checks the codes itself).
+                        if i == 2 {
+                            drive::set_current_sense_healthy(fault.is_none());
+                            if fault.is_some() {
+                                safe::drive_safe();
+                            }
                         }
+                    }
+                    if let [normal, tangential, _] = *triplet {
+                        cells::publish(RawPair { normal, tangential });
                     }
                 }
             }
             Err(_) => overruns = overruns.saturating_add(1),
         }
         #[cfg(feature = "bringup")]
-        hold.poll();
+        {
+            since_poll += TRIPLETS_PER_READ as u32;
+            if since_poll >= HOLD_POLL_TRIPLETS {
+                since_poll = 0;
+                hold.poll();
+            }
+        }
         if Instant::now() >= next_log {
             next_log += LOG_PERIOD;
             log_sensors(&mut logs, &guard, overruns);
@@ -130,20 +167,16 @@ pub async fn run(mut hw: Hardware) {
     }
 }
 
-/// Tares the current channel from the current samples of `block` if their mean is near the
-/// nominal zero, and moves the trip threshold with it.
+/// Tares the current channel from `codes` (current samples with the drive off) if their mean is
+/// near the nominal zero, and moves the trip threshold with it.
 fn tare_current(
     current: &mut SensorChannel,
-    block: &Block,
+    codes: &[i32],
     nominal: &Calibration,
     guard: &mut OvercurrentGuard,
 ) {
-    let mut codes = [0i32; TRIPLETS_PER_READ];
-    for (code, triplet) in codes.iter_mut().zip(block.chunks_exact(CHANNELS)) {
-        *code = i32::from(triplet[2]);
-    }
     let before = current.calibration();
-    if current.tare(&codes).is_err()
+    if current.tare(codes).is_err()
         || !sensing::plausible_zero(current.calibration().offset(), nominal.offset())
     {
         defmt::warn!("current sense not at mid-scale with the drive off; nominal zero kept");
@@ -209,7 +242,7 @@ fn log_sensors(logs: &mut [ChannelLog; 3], guard: &OvercurrentGuard, overruns: u
     defmt::info!(
         "sense: normal {=i32} mN (code {=i32}), tangential {=i32} mN (code {=i32}), \
          current {=i32} mA (code {=i32}); comparator {=bool}, break {=bool}, outputs {=bool}, \
-         overruns {=u32}",
+         overruns {=u32}, pairs dropped {=u32}",
         normal.0,
         normal.1,
         tangential.0,
@@ -219,7 +252,8 @@ fn log_sensors(logs: &mut [ChannelLog; 3], guard: &OvercurrentGuard, overruns: u
         guard.over_threshold(),
         drive::break_tripped(),
         drive::outputs_enabled(),
-        overruns
+        overruns,
+        cells::dropped()
     );
     for (name, (_, _, faults, last)) in [
         ("normal", normal),

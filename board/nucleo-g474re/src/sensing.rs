@@ -23,8 +23,13 @@ use crate::config;
 
 /// Channels in the regular sequence, in order.
 pub const CHANNELS: usize = 3;
-/// Triplets per half of the DMA ring buffer (one `read`): 38 ms at 40 kHz.
-pub const TRIPLETS_PER_READ: usize = 32;
+/// Triplets per half of the DMA ring buffer (one `read`): one, so each triplet reaches the
+/// control loop as soon as it is converted (1.2 ms at 40 kHz) rather than in bursts. The DMA
+/// interrupts once per triplet (833 Hz at 40 kHz); the reader has one triplet's time to take a
+/// half before the DMA laps it (an overrun loses samples, the ring re-aligns to the sequence).
+pub const TRIPLETS_PER_READ: usize = 1;
+/// TIM1 triggers (PWM periods) per triplet: the oversampling ratio times the channels, 48.
+pub const TRIGGERS_PER_TRIPLET: u32 = config::OVERSAMPLING.ratio() * CHANNELS as u32;
 /// DMA ring buffer: two halves.
 const RING_LEN: usize = 2 * CHANNELS * TRIPLETS_PER_READ;
 

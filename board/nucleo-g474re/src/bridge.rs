@@ -1,0 +1,221 @@
+//! The half-bridge as the control loop's actuator: the controller's amplitude command written
+//! to TIM1 ([`crate::drive`]), and the bridge switched on only while the controller drives.
+//!
+//! Each step [`Bridge::apply`] either drives (state `ramp-up`, `running` or `ramp-down`, no
+//! latched fault: duty for the amplitude, MOE set) or makes the drive safe (MOE cleared, duty
+//! zero) in every other state, so a controller fault (a sensor fault, an overrun, a model
+//! error) stops the bridge in the step it is latched. The bridge refuses to switch on, and
+//! reports it, while the overcurrent break is active or unacknowledged or the current sense is
+//! faulty; it reports it too when MOE has dropped under it (the comparator's break, or the
+//! sensing task's reaction to a faulty current sense). The control loop then latches the
+//! controller's `overcurrent` fault; `clear` acknowledges the break ([`Bridge::acknowledge`]).
+//!
+//! # Amplitude scale (an assumption)
+//!
+//! The controller's amplitude is a fraction of the *scene's* full-scale stack voltage
+//! (`actuator.full_scale_voltage_v`: 5.25 V in `reference`); the board's [`Amplitude`] is a
+//! fraction of the half-bridge's full-scale fundamental ([`config::FULL_SCALE_V`], 15.28 V on a
+//! 24 V bus, assuming the output network passes the fundamental unchanged: bring-up step 9
+//! measures it). The command is scaled by their ratio, so a command means the same volts on
+//! the stack as in the scene, and capped by the stack's ratings at the drive frequency
+//! ([`config::STACK`]) as a second line behind the controller's own ceiling. A scene whose full
+//! scale exceeds the bridge's cannot run on this board.
+//!
+//! In the `bringup` build the hold-to-run button owns the bridge: this module never writes
+//! TIM1 there (the control loop refuses `start`, `freq` and `scene`, see [`crate::rig`]).
+
+use sonolube::control::Output;
+use sonolube::drive::{Amplitude, DriveError, DriveLimits, DriveTiming, Frequency};
+use sonolube::fx::{Q1_31, Q2_30};
+use sonolube::protocol::SupervisorState;
+
+use crate::{config, drive, safe};
+
+/// Whether the control loop drives the bridge: not in the bring-up build.
+pub const CONTROLS_BRIDGE: bool = cfg!(not(feature = "bringup"));
+
+/// Why the bridge is not switching although the controller drives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, defmt::Format)]
+pub enum Stopped {
+    /// The overcurrent comparator's break fired (or its flag is not acknowledged).
+    Break,
+    /// The current sense is saturated or disconnected.
+    CurrentSense,
+    /// MOE dropped with neither of the above (the sensing task cleared it on a faulty current
+    /// sample that has since recovered).
+    OutputsDropped,
+}
+
+/// Why a scene's drive cannot run on this board.
+#[derive(Debug, Clone, Copy, PartialEq, defmt::Format)]
+pub enum DriveRefusal {
+    /// The scene's drive frequency is outside the stack's 20-60 kHz band.
+    FrequencyOutOfBand {
+        /// The scene's drive frequency, mHz.
+        millihertz: u32,
+    },
+    /// The scene's full-scale stack voltage exceeds the bridge's full-scale fundamental.
+    FullScaleVoltage {
+        /// The scene's, V.
+        scene_v: f64,
+        /// The bridge's, V.
+        bridge_v: f64,
+    },
+    /// TIM1 cannot make the timing, or the stack ratings are unusable.
+    Drive(DriveError),
+}
+
+/// The bridge settings of one scene and whether the control loop has switched it on.
+pub struct Bridge {
+    timing: DriveTiming,
+    /// Bridge amplitude per controller amplitude, Q2.30 in (0, 1].
+    scale_q30: i64,
+    /// The stack ratings' ceiling at the drive frequency.
+    ceiling: Amplitude,
+    /// The amplitude last written.
+    amplitude: Amplitude,
+    /// Whether this loop set MOE and has not cleared it since.
+    on: bool,
+}
+
+impl Bridge {
+    /// The bridge for a scene whose drive runs at `drive_hz` with `full_scale_voltage_v` on the
+    /// stack at full command. Configuration (`f64`), once per scene; writes nothing.
+    pub fn for_scene(drive_hz: f64, full_scale_voltage_v: f64) -> Result<Self, DriveRefusal> {
+        // `as` saturates (and maps NaN to 0), which the band check then refuses.
+        let frequency = Frequency::from_millihertz((drive_hz * 1000.0 + 0.5) as u32);
+        if !frequency.in_band() {
+            return Err(DriveRefusal::FrequencyOutOfBand {
+                millihertz: frequency.millihertz(),
+            });
+        }
+        let ratio = full_scale_voltage_v / config::FULL_SCALE_V;
+        if !(ratio > 0.0 && ratio <= 1.0) {
+            return Err(DriveRefusal::FullScaleVoltage {
+                scene_v: full_scale_voltage_v,
+                bridge_v: config::FULL_SCALE_V,
+            });
+        }
+        let timing = config::TIMING
+            .retune(frequency)
+            .map_err(DriveRefusal::Drive)?;
+        let limits =
+            DriveLimits::new(&config::STACK, config::FULL_SCALE_V).map_err(DriveRefusal::Drive)?;
+        Ok(Self {
+            timing,
+            // ratio in (0, 1]: at most 2^30.
+            scale_q30: (ratio * (1u64 << 30) as f64 + 0.5) as i64,
+            ceiling: limits.max_amplitude(frequency),
+            amplitude: Amplitude::ZERO,
+            on: false,
+        })
+    }
+
+    /// Writes this scene's period and ADC trigger to TIM1, with zero amplitude. Call with the
+    /// bridge off (a scene is selected only with the drive off).
+    pub fn install(&mut self) {
+        if CONTROLS_BRIDGE {
+            self.amplitude = Amplitude::ZERO;
+            drive::write_timing(&self.timing, Amplitude::ZERO);
+        }
+    }
+
+    /// The timing for a new drive frequency (`freq` command), checked but not yet written.
+    pub fn timing_at(&self, frequency: Frequency) -> Result<DriveTiming, DriveError> {
+        self.timing.retune(frequency)
+    }
+
+    /// Switches to `timing` (from [`Self::timing_at`]): a running bridge changes period at the
+    /// next PWM period boundary, glitch-free (preloaded registers), with the same amplitude.
+    pub fn retune(&mut self, timing: DriveTiming) {
+        self.timing = timing;
+        if let Ok(limits) = DriveLimits::new(&config::STACK, config::FULL_SCALE_V) {
+            self.ceiling = limits.max_amplitude(timing.frequency());
+        }
+        self.amplitude = self.amplitude.min(self.ceiling);
+        if CONTROLS_BRIDGE {
+            drive::write_timing(&self.timing, self.amplitude);
+        }
+    }
+
+    /// Applies one controller output: drive at its amplitude in the driving states, safe in
+    /// every other. Err when the bridge should switch but does not (see [`Stopped`]); the
+    /// bridge is then safe.
+    pub fn apply(&mut self, output: &Output) -> Result<(), Stopped> {
+        if !CONTROLS_BRIDGE {
+            return Ok(());
+        }
+        let drives = matches!(
+            output.state,
+            SupervisorState::RampUp | SupervisorState::Running | SupervisorState::RampDown
+        ) && output.fault.is_none();
+        if !drives {
+            self.off();
+            return Ok(());
+        }
+        self.amplitude = self.bridge_amplitude(output.amplitude);
+        drive::set_amplitude(&self.timing, self.amplitude);
+        // The break flag first: a short overcurrent pulse may have cleared MOE and gone again
+        // before this step; its sticky flag still tells.
+        let stopped = if drive::break_tripped() {
+            Some(Stopped::Break)
+        } else if self.on {
+            if drive::outputs_enabled() {
+                None
+            } else if !drive::current_sense_healthy() {
+                Some(Stopped::CurrentSense)
+            } else {
+                Some(Stopped::OutputsDropped)
+            }
+        } else if !drive::current_sense_healthy() {
+            Some(Stopped::CurrentSense)
+        } else if drive::try_enable_outputs() {
+            None
+        } else {
+            // MOE did not stick: the break input went active in between.
+            Some(Stopped::Break)
+        };
+        match stopped {
+            None => {
+                self.on = true;
+                Ok(())
+            }
+            Some(cause) => {
+                self.off();
+                Err(cause)
+            }
+        }
+    }
+
+    /// Makes the drive safe now: MOE cleared, duty zero.
+    pub fn off(&mut self) {
+        if !CONTROLS_BRIDGE {
+            return;
+        }
+        safe::drive_safe();
+        self.on = false;
+        if self.amplitude != Amplitude::ZERO {
+            self.amplitude = Amplitude::ZERO;
+            drive::set_amplitude(&self.timing, Amplitude::ZERO);
+        }
+    }
+
+    /// Acknowledges a break after the controller's fault was cleared: the next switch-on is
+    /// allowed if the comparator no longer trips (a standing overcurrent sets the flag again).
+    pub fn acknowledge(&mut self) {
+        if CONTROLS_BRIDGE && !self.on {
+            drive::clear_break_flag();
+        }
+    }
+
+    /// The controller's `amplitude` (Q1.31 of the scene's full scale) as the bridge's, capped.
+    fn bridge_amplitude(&self, amplitude: Q1_31) -> Amplitude {
+        let command = i64::from(amplitude.to_bits().max(0));
+        // Q1.31 x Q2.30 >> 31 = Q2.30; at most 2^30 (both factors at most 1).
+        let bits = ((command * self.scale_q30 + (1 << 30)) >> 31).clamp(0, 1 << 30);
+        let bits = i32::try_from(bits).unwrap_or(0);
+        Amplitude::new(Q2_30::from_bits(bits))
+            .unwrap_or(Amplitude::ZERO)
+            .min(self.ceiling)
+    }
+}

@@ -1,0 +1,358 @@
+//! The board's control loop: the firmware's station on the real load cells and the real
+//! half-bridge.
+//!
+//! Each period the newest load-cell pair from the sensing task ([`crate::cells`]) goes, in the
+//! scene cell's format, through the station (sensing chain, controller, model) of the selected
+//! scene, and the controller's output goes to the bridge ([`crate::bridge`]). This is the
+//! QEMU board's rig with hardware where the simulated plant was.
+//!
+//! # What the board cannot measure
+//!
+//! - **Sliding velocity**: the rig has no velocity sensor. The station is given the scene's
+//!   set speed (the first breakpoint of its sliding-velocity profile: 0.038 m/s in
+//!   `reference`) every period, so the controller always believes the contact slides at that
+//!   speed. The operator must run the slide at that speed before `start`; with the slide
+//!   stopped the controller would still drive (and learn a wrong natural friction).
+//! - **Fresh samples every period**: the cells are converted at 833 pairs/s (40 kHz drive), so
+//!   each pair is held for several periods; the station's stuck-reading check is widened by the
+//!   longest hold in the drive band ([`hold_steps`]). A pair older than [`STALE_HOLDS`] holds
+//!   (sensing has stopped) is given to the station as the cells' low-rail code, which it reads
+//!   as a disconnected normal-force sensor: a sensor fault, drive safe.
+
+use core::fmt::Write as _;
+
+use cortex_m::peripheral::DWT;
+use sonolube::control::{ExternalFault, Reason};
+use sonolube::drive::Frequency;
+use sonolube::protocol::{Axis, Command, DRIVE_FREQ, ProtocolError, SupervisorState, TokenText};
+use sonolube::scene::{LoadCell, Scene};
+use sonolube::sense::{SenseError, SensorChannel};
+use sonolube::sim::{SimError, fault_limits};
+use sonolube::station::{CellBench, Sample, Station};
+use sonolube_app::control::ControlLoop;
+use sonolube_app::snapshot::Snapshot;
+
+use crate::bridge::{Bridge, CONTROLS_BRIDGE, DriveRefusal};
+use crate::cells::{CellFeed, CodeMap, RawPair};
+use crate::sensing::TRIGGERS_PER_TRIPLET;
+use crate::{config, drive};
+
+/// A pair held for more than this many times the longest expected hold is stale.
+pub const STALE_HOLDS: u32 = 8;
+
+/// Why a scene cannot run on this board.
+#[derive(Debug, Clone, Copy, PartialEq, defmt::Format)]
+pub enum SceneRefusal {
+    /// The station (model, controller, cells) cannot be built from the scene.
+    Station(SimError),
+    /// The bridge cannot run the scene's drive.
+    Drive(DriveRefusal),
+    /// The board's load-cell calibration ([`config::LOAD_CELL_INTERNAL`]) is unusable.
+    Cells(SenseError),
+}
+
+/// Everything that depends on the scene, built whole before it replaces the running one.
+struct Setup {
+    scene: &'static Scene<'static>,
+    station: Station,
+    maps: [CodeMap; 2],
+    bridge: Bridge,
+    sliding_velocity_m_per_s: f32,
+    stale_after_steps: u32,
+}
+
+impl Setup {
+    /// Configuration (`f64`, the model's tables), between two steps; its duration on silicon
+    /// is unmeasured (an overrun is counted if it exceeds a period).
+    fn new(scene: &'static Scene<'static>) -> Result<Self, SceneRefusal> {
+        let real = config::LOAD_CELL_INTERNAL
+            .calibration()
+            .map_err(SceneRefusal::Cells)?;
+        // The cheap check first: a scene the bridge cannot drive builds no model.
+        let bridge = Bridge::for_scene(
+            scene.transducer.drive_hz,
+            scene.actuator.full_scale_voltage_v,
+        )
+        .map_err(SceneRefusal::Drive)?;
+        let mut station = Station::for_scene(scene).map_err(SceneRefusal::Station)?;
+        let hold = hold_steps(scene.control_rate_hz);
+        let (normal, tangential) = station.channels_mut();
+        widen_stuck_check(normal, &scene.normal_cell, hold);
+        widen_stuck_check(tangential, &scene.tangential_cell, hold);
+        let sliding_velocity_m_per_s = scene
+            .sliding_velocity_m_per_s
+            .first()
+            .map_or(0.0, |point| point.value as f32);
+        Ok(Self {
+            scene,
+            station,
+            maps: [
+                CodeMap::new(&scene.normal_cell, &real),
+                CodeMap::new(&scene.tangential_cell, &real),
+            ],
+            bridge,
+            sliding_velocity_m_per_s,
+            stale_after_steps: hold.saturating_mul(STALE_HOLDS),
+        })
+    }
+}
+
+/// Control periods a pair is held at most: the control rate over the pair rate at the lowest
+/// drive frequency of the band (the ADC is triggered once per PWM period), rounded up (24 at
+/// 10 kHz: 20 kHz / 48 triggers = 417 pairs/s).
+pub fn hold_steps(control_rate_hz: f64) -> u32 {
+    // Control periods times triggers per pair, rounded up (`as` saturates, NaN gives 0).
+    let exact = control_rate_hz * f64::from(TRIGGERS_PER_TRIPLET);
+    let truncated = exact as u64;
+    let triggers = truncated + u64::from((truncated as f64) < exact);
+    let band_min_hz = u64::from(Frequency::BAND_MIN.hz_rounded()).max(1);
+    let hold = triggers.div_ceil(band_min_hz).max(1);
+    u32::try_from(hold).unwrap_or(u32::MAX)
+}
+
+/// The station's channel with its stuck check counting `hold` times as many periods: a held
+/// pair repeats its code for `hold` periods, which is no sign of a stuck cell.
+fn widen_stuck_check(channel: &mut SensorChannel, cell: &LoadCell, hold: u32) {
+    let mut limits = fault_limits(cell);
+    limits.stuck_samples = limits.stuck_samples.saturating_mul(hold);
+    *channel = SensorChannel::new(channel.format(), limits, channel.calibration());
+}
+
+/// The board's control loop on one scene.
+pub struct BoardRig {
+    setup: Setup,
+    feed: CellFeed,
+}
+
+impl BoardRig {
+    /// The rig of `scene`, its first sample `first`, its drive timing written to TIM1.
+    pub fn new(scene: &'static Scene<'static>, first: RawPair) -> Result<Self, SceneRefusal> {
+        let mut setup = Setup::new(scene)?;
+        setup.bridge.install();
+        Ok(Self {
+            setup,
+            feed: CellFeed::new(first),
+        })
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &'static Scene<'static> {
+        self.setup.scene
+    }
+
+    /// `scene NAME`: the new scene's station replaces the old one (calibration, target and
+    /// latched fault included), with the drive off.
+    fn select_scene(&mut self, command: &Command) -> Result<(), ProtocolError> {
+        let Command::Scene(name) = *command else {
+            return Err(self.wrong_state(command));
+        };
+        let state = self.setup.station.state();
+        if !matches!(
+            state,
+            SupervisorState::Idle | SupervisorState::Fault | SupervisorState::Boot
+        ) {
+            return Err(ProtocolError::WrongState {
+                command: command.keyword(),
+                state,
+            });
+        }
+        let Some(scene) = sonolube::scene::builtin::find(name.as_str()) else {
+            return Err(ProtocolError::UnknownScene { name });
+        };
+        match Setup::new(scene) {
+            Ok(setup) => {
+                self.setup.bridge.off();
+                self.setup = setup;
+                self.setup.bridge.install();
+                defmt::info!(
+                    "scene {=str}: {=f64} Hz control, drive {=f64} Hz, set speed {=f32} m/s",
+                    scene.name,
+                    scene.control_rate_hz,
+                    scene.transducer.drive_hz,
+                    self.setup.sliding_velocity_m_per_s
+                );
+                Ok(())
+            }
+            Err(refusal) => {
+                defmt::error!(
+                    "scene {=str} cannot run on this board: {}",
+                    scene.name,
+                    refusal
+                );
+                Err(ProtocolError::UnknownScene { name })
+            }
+        }
+    }
+
+    /// `freq`: the station takes the frequency (it checks the protocol's range) if TIM1 can run
+    /// at it, then TIM1 switches to it.
+    fn set_frequency(&mut self, command: &Command, freq_chz: u32) -> Result<(), ProtocolError> {
+        let frequency = Frequency::from_millihertz(freq_chz.saturating_mul(10));
+        let timing = match self.setup.bridge.timing_at(frequency) {
+            Ok(timing) if frequency.in_band() => timing,
+            // The protocol's range is the band, where every frequency has a timing (config.rs
+            // checks the dead time at 60 kHz): only a command built by a program gets here.
+            _ => {
+                let mut token = Text::default();
+                let _ = write!(token, "{}.{:02}", freq_chz / 100, freq_chz % 100);
+                return Err(ProtocolError::OutOfRange {
+                    token: TokenText::new(token.as_str()),
+                    quantity: &DRIVE_FREQ,
+                });
+            }
+        };
+        let mut bench = Bench {
+            feed: &self.feed,
+            maps: &self.setup.maps,
+            fresh: false,
+        };
+        self.setup.station.execute(command, &mut bench)?;
+        self.setup.bridge.retune(timing);
+        Ok(())
+    }
+
+    fn wrong_state(&self, command: &Command) -> ProtocolError {
+        ProtocolError::WrongState {
+            command: command.keyword(),
+            state: self.setup.station.state(),
+        }
+    }
+}
+
+/// A few bytes of text: the token of a refusal.
+#[derive(Default)]
+struct Text {
+    bytes: [u8; 16],
+    len: usize,
+}
+
+impl Text {
+    fn as_str(&self) -> &str {
+        self.bytes
+            .get(..self.len)
+            .and_then(|bytes| core::str::from_utf8(bytes).ok())
+            .unwrap_or("?")
+    }
+}
+
+impl core::fmt::Write for Text {
+    fn write_str(&mut self, text: &str) -> core::fmt::Result {
+        let end = self.len + text.len();
+        let slot = self.bytes.get_mut(self.len..end).ok_or(core::fmt::Error)?;
+        slot.copy_from_slice(text.as_bytes());
+        self.len = end;
+        Ok(())
+    }
+}
+
+/// `tare` and `cal` on the real cells: the newest samples from the history (see
+/// [`CellFeed::burst`]). `load_n` is ignored: the operator has put that load on the cell.
+struct Bench<'a> {
+    feed: &'a CellFeed,
+    maps: &'a [CodeMap; 2],
+    fresh: bool,
+}
+
+impl CellBench for Bench<'_> {
+    fn burst(&mut self, axis: Axis, _load_n: f32, codes: &mut [i32]) -> bool {
+        let map = match axis {
+            Axis::Normal => &self.maps[0],
+            Axis::Tangential => &self.maps[1],
+        };
+        self.feed.burst(axis, map, self.fresh, codes)
+    }
+}
+
+impl ControlLoop for BoardRig {
+    /// The DWT cycle counter counts the 170 MHz core clock.
+    const CYCLE_HZ: u64 = 170_000_000;
+
+    fn rate_hz(&self) -> u32 {
+        // Scenes run at 1 to 100 kHz.
+        self.setup.scene.control_rate_hz as u32
+    }
+
+    fn step(&mut self) -> Option<Snapshot> {
+        let start = DWT::cycle_count();
+        let setup = &mut self.setup;
+        let (pair, held) = self.feed.take(drive::outputs_enabled());
+        let (normal_code, tangential_code) = if held > setup.stale_after_steps {
+            // No pair for too long: the converter reads as disconnected (low rail).
+            (0, 0)
+        } else {
+            (
+                setup.maps[0].convert(pair.normal),
+                setup.maps[1].convert(pair.tangential),
+            )
+        };
+        let control = setup.station.control(&Sample {
+            normal_code,
+            tangential_code,
+            sliding_velocity_m_per_s: setup.sliding_velocity_m_per_s,
+        });
+        let applied = setup.bridge.apply(&control.output);
+        let cycles = DWT::cycle_count().wrapping_sub(start);
+        if let Err(cause) = applied {
+            defmt::error!(
+                "bridge stopped while driving ({}): overcurrent fault",
+                cause
+            );
+            setup
+                .station
+                .controller_mut()
+                .trip(ExternalFault::Overcurrent);
+        }
+        Some(Snapshot::new(
+            &control.output,
+            setup.station.controller().target(),
+            setup.scene.name,
+            setup.station.drive_hz(),
+            control
+                .sensor_fault
+                .map(|fault| Reason::SensorFault(fault).name()),
+            cycles,
+        ))
+    }
+
+    fn execute(&mut self, command: &Command) -> Result<(), ProtocolError> {
+        if !CONTROLS_BRIDGE
+            && matches!(
+                command,
+                Command::Start | Command::Freq { .. } | Command::Scene(_)
+            )
+        {
+            defmt::warn!(
+                "bring-up build: B1 owns the bridge, `{=str}` is refused",
+                command.keyword()
+            );
+            return Err(self.wrong_state(command));
+        }
+        match *command {
+            Command::Scene(_) => self.select_scene(command),
+            Command::Freq { freq_chz } => self.set_frequency(command, freq_chz),
+            _ => {
+                let fresh = self.feed.is_fresh(self.setup.stale_after_steps);
+                let result = self.setup.station.execute(
+                    command,
+                    &mut Bench {
+                        feed: &self.feed,
+                        maps: &self.setup.maps,
+                        fresh,
+                    },
+                );
+                if result.is_ok() && matches!(command, Command::Clear) {
+                    self.setup.bridge.acknowledge();
+                }
+                result
+            }
+        }
+    }
+
+    fn trip_overrun(&mut self) {
+        self.setup
+            .station
+            .controller_mut()
+            .trip(ExternalFault::Overrun);
+        self.setup.bridge.off();
+    }
+}
