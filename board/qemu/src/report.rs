@@ -78,7 +78,7 @@ pub fn verdicts(scene: &str, summary: &RunSummary) -> bool {
             }
             Measured::Periods(n) => {
                 defmt::info!(
-                    "{=str} {} measured {=u32} periods",
+                    "{=str} {} measured {=u32} period(s)",
                     passed,
                     verdict.criterion,
                     n
