@@ -67,6 +67,8 @@ pub struct Station {
     normal: SensorChannel,
     tangential: SensorChannel,
     drive_hz: f32,
+    /// The same frequency in the protocol's cHz, for reports (set with `drive_hz`).
+    drive_freq_chz: u32,
 }
 
 impl Station {
@@ -81,6 +83,8 @@ impl Station {
             normal: sensor_channel(&scene.normal_cell)?,
             tangential: sensor_channel(&scene.tangential_cell)?,
             drive_hz: scene.transducer.drive_hz as f32,
+            // Scene drive frequencies are validated to 20-60 kHz: the cast cannot wrap.
+            drive_freq_chz: libm::round(scene.transducer.drive_hz * 100.0) as u32,
         })
     }
 
@@ -140,6 +144,7 @@ impl Station {
                     });
                 }
                 self.drive_hz = freq_chz as f32 / 100.0;
+                self.drive_freq_chz = freq_chz;
                 Ok(())
             }
             Command::Tare(axes) => {
@@ -219,6 +224,11 @@ impl Station {
     /// The drive frequency, Hz.
     pub fn drive_hz(&self) -> f32 {
         self.drive_hz
+    }
+
+    /// The drive frequency in cHz (0.01 Hz), as the protocol reports it.
+    pub fn drive_freq_chz(&self) -> u32 {
+        self.drive_freq_chz
     }
 
     /// The controller.
@@ -360,6 +370,7 @@ mod tests {
             Ok(())
         );
         assert_eq!(run.station().drive_hz(), 39_500.5);
+        assert_eq!(run.station().drive_freq_chz(), 3_950_050);
         // Not the loop's commands.
         assert_eq!(
             code(run.execute(&Command::Version)),

@@ -54,7 +54,7 @@ impl Snapshot {
         output: &Output,
         target: Option<Target>,
         scene: &'static str,
-        drive_hz: f32,
+        drive_freq_chz: u32,
         active_fault: Option<&'static str>,
         control_cycles: u32,
     ) -> Self {
@@ -66,7 +66,7 @@ impl Snapshot {
             normal_force_mn: newtons_to_mn(output.estimate.normal_force),
             tangential_force_mn: newtons_to_mn(output.estimate.tangential_force),
             drive_amplitude_ppm: amplitude_ppm(output.amplitude),
-            drive_freq_chz: hz_to_chz(drive_hz),
+            drive_freq_chz,
             latched_fault: output.fault.map(|reason| reason.name()),
             active_fault,
             control_cycles,
@@ -108,30 +108,23 @@ impl Snapshot {
     }
 }
 
-/// Q2.30 coefficient [0, 2) to ppm, rounded: fits a u32.
+/// Q2.30 coefficient [0, 2) to ppm, rounded.
 fn coefficient_ppm(coefficient: Q2_30) -> u32 {
-    let bits = i64::from(coefficient.to_bits().max(0));
-    u32::try_from((bits * 1_000_000 + (1 << 29)) >> 30).unwrap_or(u32::MAX)
+    unsigned(coefficient.round_scaled(1_000_000))
 }
 
 /// Q16.16 newtons (+-32768 N) to mN, rounded: fits an i32.
 fn newtons_to_mn(force: Q16_16) -> i32 {
-    let bits = i64::from(force.to_bits());
-    i32::try_from((bits * 1_000 + (1 << 15)) >> 16).unwrap_or(i32::MAX)
+    force.round_scaled(1_000) as i32
 }
 
 /// Q1.31 amplitude [0, 1) to ppm, rounded.
 fn amplitude_ppm(amplitude: Q1_31) -> u32 {
-    let bits = i64::from(amplitude.to_bits().max(0));
-    u32::try_from((bits * 1_000_000 + (1 << 30)) >> 31).unwrap_or(u32::MAX)
+    unsigned(amplitude.round_scaled(1_000_000))
 }
 
-/// Hz to cHz, rounded; 0 for a negative or non-finite value.
-fn hz_to_chz(hz: f32) -> u32 {
-    let chz = hz * 100.0 + 0.5;
-    if chz.is_finite() && chz >= 0.0 && chz < u32::MAX as f32 {
-        chz as u32
-    } else {
-        0
-    }
+/// A non-negative scaled value as a `u32`; negative values (which these quantities never
+/// take) as 0.
+fn unsigned(scaled: i64) -> u32 {
+    u32::try_from(scaled.max(0)).unwrap_or(u32::MAX)
 }

@@ -105,9 +105,9 @@ impl PreparedTarget {
 }
 
 /// `value * unit`, rounded, negative values as 0.
-fn scale_unit(value: Q2_30, unit: i64) -> u32 {
-    let scaled = (value.to_bits().max(0) as i64 * unit + (1 << 29)) >> 30;
-    scaled as u32 // < 2 unit <= 2e6
+fn scale_unit(value: Q2_30, unit: u32) -> u32 {
+    // < 2 unit <= 2e6: fits.
+    value.round_scaled(unit).clamp(0, u32::MAX as i64) as u32
 }
 
 #[cfg(test)]

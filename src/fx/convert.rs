@@ -168,11 +168,44 @@ impl<const FRAC: u32> Q<FRAC> {
             raw::shr_round_i64(self.to_bits() as i64, FRAC) as i32
         }
     }
+
+    /// The value times `unit`, rounded to the nearest integer (ties toward +infinity): a
+    /// quantity in a finer integer unit, for example newtons to mN with `unit` 1000. Exact
+    /// and never overflows (`|bits x unit| < 2^63`).
+    pub const fn round_scaled(self, unit: u32) -> i64 {
+        let product = self.to_bits() as i64 * unit as i64;
+        if FRAC == 0 {
+            product
+        } else {
+            raw::shr_round_i64(product, FRAC)
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::super::q::{Q1_31, Q2_30, Q16_16};
+
+    #[test]
+    fn round_scaled_is_exact_at_the_extremes() {
+        assert_eq!(Q16_16::from_bits(i32::MAX).round_scaled(1_000), 32_768_000);
+        assert_eq!(Q16_16::from_bits(i32::MIN).round_scaled(1_000), -32_768_000);
+        assert_eq!(
+            Q1_31::from_bits(i32::MAX).round_scaled(1_000_000),
+            1_000_000
+        );
+        assert_eq!(Q2_30::from_bits(1).round_scaled(u32::MAX), 4);
+        // 0.0005 N is half a mN: ties go up; -0.0005 N goes to 0.
+        let half_mn = Q16_16::from_f64(0.000_5).unwrap().to_bits();
+        let exact = |bits: i32| (f64::from(bits) * 1000.0 / 65536.0 + 0.5).floor() as i64;
+        for bits in [half_mn, -half_mn, 1, -1, 12_345_678, -12_345_678] {
+            assert_eq!(
+                Q16_16::from_bits(bits).round_scaled(1_000),
+                exact(bits),
+                "{bits}"
+            );
+        }
+    }
     use super::*;
     use proptest::prelude::*;
 

@@ -306,7 +306,7 @@ impl ControlLoop for BoardRig {
             &control.output,
             setup.station.controller().target(),
             setup.scene.name,
-            setup.station.drive_hz(),
+            setup.station.drive_freq_chz(),
             control
                 .sensor_fault
                 .map(|fault| Reason::SensorFault(fault).name()),

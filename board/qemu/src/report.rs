@@ -27,7 +27,7 @@ pub fn cpu(stats: &LoopStats, busy_cycles: u64, elapsed_cycles: u64, icount_shif
         stats.overruns
     );
     if let Some(shift) = icount_shift {
-        let per_cycle = 40u64 >> shift.min(5);
+        let per_cycle = instructions_per_cycle(shift);
         defmt::info!(
             "control step: mean {=u64} max {=u64} instructions (-icount shift={=u8}, {=u64} instructions per cycle)",
             mean * per_cycle,
@@ -46,6 +46,12 @@ pub fn cpu(stats: &LoopStats, busy_cycles: u64, elapsed_cycles: u64, icount_shif
     }
 }
 
+/// Guest instructions per 25 MHz core cycle (40 ns) under `-icount shift=N` (2^N ns per
+/// instruction).
+fn instructions_per_cycle(shift: u8) -> u64 {
+    40u64 >> shift.min(5)
+}
+
 /// Prints what the simulated plant and the judge cost per step (left out of the firmware's
 /// clock), for the record: it is QEMU's work, not the firmware's.
 pub fn plant(stats: &LoopStats, excluded_cycles: u64, icount_shift: Option<u8>) {
@@ -55,7 +61,7 @@ pub fn plant(stats: &LoopStats, excluded_cycles: u64, icount_shift: Option<u8>) 
     ) {
         defmt::info!(
             "simulated plant and judge: {=u64} instructions per step (not firmware time)",
-            per_step * (40u64 >> shift.min(5))
+            per_step * instructions_per_cycle(shift)
         );
     }
 }

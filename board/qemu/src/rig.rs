@@ -10,7 +10,7 @@
 //! the plant reading the board's drive output instead of the controller's command directly.
 
 use sonolube::control::ExternalFault;
-use sonolube::protocol::{Command, ProtocolError};
+use sonolube::protocol::{Command, ProtocolError, SceneName};
 use sonolube::scene::Scene;
 use sonolube::sim::{ClosedLoop, Mode, RunSummary, SimError};
 use sonolube_app::control::ControlLoop;
@@ -47,7 +47,7 @@ impl SimulatedRig {
 
     /// `scene NAME` under the console: a new rig with that scene's plant and station, when
     /// the drive is off.
-    fn select_scene(&mut self, command: &Command, name: &str) -> Result<(), ProtocolError> {
+    fn select_scene(&mut self, command: &Command, name: SceneName) -> Result<(), ProtocolError> {
         use sonolube::protocol::SupervisorState::{Boot, Fault, Idle};
         let state = self.run.controller().state();
         if !matches!(state, Idle | Fault | Boot) {
@@ -56,8 +56,9 @@ impl SimulatedRig {
                 state,
             });
         }
-        let Some(scene) = sonolube::scene::builtin::find(name) else {
-            return Err(unknown_scene(command));
+        let unknown = ProtocolError::UnknownScene { name };
+        let Some(scene) = sonolube::scene::builtin::find(name.as_str()) else {
+            return Err(unknown);
         };
         let run = time_driver::exclude(|| ClosedLoop::operated(scene));
         match run {
@@ -67,20 +68,10 @@ impl SimulatedRig {
                 Ok(())
             }
             Err(error) => {
-                defmt::error!("scene {=str} cannot run: {}", name, error);
-                Err(unknown_scene(command))
+                defmt::error!("scene {=str} cannot run: {}", name.as_str(), error);
+                Err(unknown)
             }
         }
-    }
-}
-
-fn unknown_scene(command: &Command) -> ProtocolError {
-    match *command {
-        Command::Scene(name) => ProtocolError::UnknownScene { name },
-        _ => ProtocolError::WrongState {
-            command: command.keyword(),
-            state: sonolube::protocol::SupervisorState::Idle,
-        },
     }
 }
 
@@ -103,7 +94,7 @@ impl ControlLoop for SimulatedRig {
             &output,
             self.run.controller().target(),
             self.scene.name,
-            self.run.station().drive_hz(),
+            self.run.station().drive_freq_chz(),
             record
                 .sensor_fault
                 .map(|fault| sonolube::control::Reason::SensorFault(fault).name()),
@@ -114,7 +105,7 @@ impl ControlLoop for SimulatedRig {
     fn execute(&mut self, command: &Command) -> Result<(), ProtocolError> {
         match command {
             Command::Scene(name) if self.run.mode() == Mode::Operated => {
-                self.select_scene(command, name.as_str())
+                self.select_scene(command, *name)
             }
             _ => time_driver::exclude(|| self.run.execute(command)),
         }
