@@ -6,9 +6,10 @@
 //! With v_total = v + v_a cos(omega t) (seed 003 eq 3) and F_T = mu W sgn(v_total) (eq 4), the
 //! period average is exactly F_avg = mu W mu_i(zeta), zeta = v / v_a, v_a = x_a omega (eq 2):
 //! mu_i(zeta) = (2/pi) asin(zeta) for |zeta| <= 1, sgn(zeta) beyond (physics-notes §1: the
-//! argument is positive for a fraction acos(-zeta)/pi of the period). `fx`'s `asin` already
-//! uses the half-angle form asin(z) = pi/2 - 2 asin(sqrt((1 - z)/2)) for |z| > 1/2, which keeps
-//! full precision where the slope of mu_i blows up at |zeta| -> 1.
+//! argument is positive for a fraction acos(-zeta)/pi of the period). It is evaluated in one
+//! pass by `fx`'s crate-internal `Q2_30::asin_frac_2_pi` (2/pi folded into the polynomial; the
+//! half-angle form mu_i = 1 - (4/pi) asin(sqrt((1 - z)/2)) for |z| > 1/2, which keeps full
+//! precision where the slope of mu_i blows up at |zeta| -> 1).
 //!
 //! Formats: the velocity ratio comes out of [`velocity_ratio`] as a [`VelocityRatio`] (zero,
 //! finite with 30 significant bits, or infinite without vibration); mu_i is Q2.30 in [-1, 1]
@@ -62,11 +63,11 @@ impl VelocityRatio {
         }
     }
 
-    /// The Littmann ratio mu_i(zeta), Q2.30 in [-1, 1] (seed 001 eq 1). Cost: a compare, and
-    /// for |zeta| < 1 one `asin` and one multiply (see [`mu_i`]).
+    /// The Littmann ratio mu_i(zeta), Q2.30 in [-1, 1] (seed 001 eq 1), with the error
+    /// bounds of [`mu_i`]. Cost: a compare, and for |zeta| < 1 the closed form of [`mu_i`].
     pub fn mu_i(&self) -> Result<Q2_30, ModelError> {
         let magnitude = match self.reversing_magnitude() {
-            Some(z) => littmann_magnitude(z)?,
+            Some(z) => z.asin_frac_2_pi().map_err(fx_error("zeta"))?,
             None => Q2_30::ONE,
         };
         Ok(if self.is_negative() {
@@ -125,40 +126,37 @@ pub fn velocity_ratio<const FV: u32>(
     })
 }
 
-/// (2/pi) asin(z) for z = |zeta| in [0, 1], Q2.30.
-fn littmann_magnitude(z: Q2_30) -> Result<Q2_30, ModelError> {
-    if z >= Q2_30::ONE {
-        return Ok(Q2_30::ONE); // exact, rather than (pi/2)(2/pi) rounded
-    }
-    let angle = z.asin().map_err(fx_error("zeta"))?;
-    angle
-        .checked_mul(Q2_30::FRAC_2_PI)
-        .map_err(fx_error("mu_i"))
-}
-
 /// The Littmann law mu_i(zeta) (seed 001 eq 1, physics-notes §1) for a velocity ratio `zeta`
 /// given in any format `Q<F>` (dimensionless, any sign: Q2.30 for |zeta| < 2 keeps 9.3e-10
 /// resolution; wider formats saturate harmlessly, since |zeta| >= 1 gives sgn(zeta)).
 ///
-/// Output: Q2.30 in [-1, 1], exact +-1 for |zeta| >= 1, odd in zeta. Error <= 2 ulp of Q2.30
-/// (1.6 ulp = 1.5e-9 measured: asin's error times 2/pi, the product's rounding and that of the
-/// 2/pi constant); relative error <= 1e-6 for |mu_i| >= 2e-3 (below, the absolute bound rules:
-/// 1e-4 relative down to |mu_i| = 2e-5). Never fails for valid
-/// formats (the `Result` carries fx errors that cannot occur after the |zeta| < 1 test).
-/// Cost, measured on the Cortex-M4 (module docs of [`super::coulomb`]): 61 instructions for
-/// |zeta| <= 1/2, 107 for 1/2 < |zeta| < 1 (the half-angle branch of `fx`'s `asin` and its
-/// square root), 14 for |zeta| >= 1, call included.
+/// Output: Q2.30 in [-1, 1], exact +-1 for |zeta| >= 1, exact 0 at 0, odd and nondecreasing
+/// in zeta (checked over every Q2.30 input). Error <= 1 ulp of Q2.30 (9.3e-10; 0.62 ulp
+/// measured for |zeta| <= 1/2, 0.88 above, over every Q2.30 input; 1.6 before: one rounding
+/// of (2/pi) asin evaluated with the gain folded into its polynomial, see `fx::asin`); relative
+/// error <= 1e-6 for |mu_i| >= 2e-3 (below, the absolute bound rules: 1e-4 relative down to
+/// |mu_i| = 2e-5). Never fails for valid formats (the `Result` carries fx errors that cannot
+/// occur after the |zeta| < 1 test).
+///
+/// Cost, measured in the QEMU bench build (`cargo build --release -p sonolube-qemu --target
+/// thumbv7em-none-eabihf --features bench`, then `SONOLUBE_ICOUNT_SHIFT=0 scripts/qemu-run`
+/// on the ELF), zeta over [-1, 1): 45 instructions per call with the bench harness that
+/// subtracts its own loop (call and return included), 48 with the first harness (commit
+/// e22f5ba: 10-25 more of `black_box` traffic; 124 there before this form). With that first
+/// harness, per branch: about 40 for |zeta| <= 1/2, 60 for 1/2 < |zeta| < 1 (the square
+/// root's three hardware divisions take 2-12 cycles each on the Cortex-M4) and 18 for
+/// |zeta| >= 1.
 pub fn mu_i<const F: u32>(zeta: Q<F>) -> Result<Q2_30, ModelError> {
-    let magnitude = zeta.saturating_abs().value;
-    let unit = match Q::<F>::from_int(1) {
-        Ok(one) => magnitude >= one,
-        Err(_) => false, // Q1.31 holds no 1.0: every value is below it
-    };
-    let value = if unit {
+    // |zeta| in units of 2^-F (2^31 for Q1.31's -1.0 included): |zeta| >= 1 <=> a >> F != 0.
+    let a = zeta.to_bits().unsigned_abs();
+    let value = if a >> F != 0 {
         Q2_30::ONE
     } else {
-        // |zeta| < 1 converts exactly (F <= 30) or rounds to at most 1.0 (F = 31).
-        littmann_magnitude(magnitude.convert::<30>().map_err(fx_error("zeta"))?)?
+        // |zeta| < 1 (a < 2^31) converts exactly (F <= 30) or rounds to at most 1.0 (F = 31).
+        Q::<F>::from_bits(a as i32)
+            .convert::<30>()
+            .and_then(Q2_30::asin_frac_2_pi)
+            .map_err(fx_error("zeta"))?
     };
     Ok(if zeta.is_negative() {
         Q2_30::from_bits(-value.to_bits())
@@ -192,16 +190,25 @@ mod tests {
         assert_eq!(mu_i(Q16_16::MAX), Ok(Q2_30::ONE));
         assert_eq!(mu_i(Q1_31::MIN).unwrap().to_f64(), -1.0);
         let third = mu_i(Q2_30::from_f64(0.5).unwrap()).unwrap().to_f64();
-        assert!((third - 1.0 / 3.0).abs() <= 2.0 * ULP);
+        assert!((third - 1.0 / 3.0).abs() <= ULP);
     }
 
-    /// Dense sweep of Q2.30 over [-1, 1] (every 511th input) against f64: <= 2 ulp, and
-    /// <= 1e-6 relative above 2e-3; odd symmetry exact.
+    /// Dense sweep of Q2.30 over [-1, 1] (every 511th input, and every input within 2^16 ulps
+    /// of 0, 1/2 and 1) against f64: <= 1 ulp, and <= 1e-6 relative above 2e-3; odd symmetry
+    /// exact, monotone.
     #[test]
     fn dense_sweep_against_f64() {
         let mut worst_ulps: f64 = 0.0;
         let mut worst_rel: f64 = 0.0;
-        for bits in (0..=(1i32 << 30)).step_by(511) {
+        let near = |c: i32| (c - (1 << 16)..=c + (1 << 16)).filter(|b| (0..=1 << 30).contains(b));
+        let mut previous = Q2_30::ZERO;
+        for (k, bits) in (0..=(1i32 << 30))
+            .step_by(511)
+            .chain(near(0))
+            .chain(near(1 << 29))
+            .chain(near(1 << 30))
+            .enumerate()
+        {
             let z = Q2_30::from_bits(bits);
             let got = mu_i(z).unwrap();
             let want = exact(z.to_f64());
@@ -214,12 +221,25 @@ mod tests {
                 mu_i(Q2_30::from_bits(-bits)).unwrap().to_bits(),
                 -got.to_bits()
             );
+            // monotone along the coarse sweep (its first 2^21 + 1 points)
+            if k <= (1 << 30) / 511 {
+                assert!(got >= previous, "not monotone at {z:?}");
+                previous = got;
+            }
         }
-        assert!(worst_ulps <= 2.0, "mu_i error {worst_ulps} ulps");
+        eprintln!("mu_i: max error {worst_ulps} ulp, relative {worst_rel:e} above 2e-3");
+        assert!(worst_ulps <= 1.0, "mu_i error {worst_ulps} ulps");
         assert!(worst_rel <= 1e-6, "mu_i relative error {worst_rel:e}");
-        // Q8.24 inputs (the format of a ratio computed from Q8.24 velocities) agree.
+        // Q8.24 and Q1.31 inputs (a ratio computed from Q8.24 velocities; the finest format,
+        // rounded to Q2.30 first: half an input ulp times the slope, 0.37 ulp at 1/2; its
+        // largest values round to 1.0) agree.
         let z = Q8_24::from_f64(0.556_368_960_468_521).unwrap();
-        assert!((mu_i(z).unwrap().to_f64() - exact(z.to_f64())).abs() <= 2.0 * ULP);
+        assert!((mu_i(z).unwrap().to_f64() - exact(z.to_f64())).abs() <= ULP);
+        for bits in [1, 3, 1 << 30, (1 << 30) + 1] {
+            let z = Q1_31::from_bits(bits);
+            assert!((mu_i(z).unwrap().to_f64() - exact(z.to_f64())).abs() <= 1.5 * ULP);
+        }
+        assert_eq!(mu_i(Q1_31::MAX), Ok(Q2_30::ONE));
     }
 
     #[test]
@@ -232,7 +252,7 @@ mod tests {
         let z = r.reversing_magnitude().unwrap();
         assert!((z.to_f64() + v.to_f64() / 0.0683).abs() < 2e-9);
         let mu = r.mu_i().unwrap().to_f64();
-        assert!((mu - exact(v.to_f64() / 0.0683)).abs() < 2.0 * ULP);
+        assert!((mu - exact(v.to_f64() / 0.0683)).abs() < ULP);
         assert_eq!(
             velocity_ratio(Q8_24::ZERO, Some(v_a)),
             Ok(VelocityRatio::Zero)
