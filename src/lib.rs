@@ -20,3 +20,4 @@ pub mod selfcheck;
 pub mod sense;
 pub mod sim;
 pub mod station;
+pub mod variant;

@@ -11,3 +11,4 @@ pub mod papers;
 pub mod plot;
 pub mod reference;
 pub mod scene_file;
+pub mod speed;

@@ -1,94 +1,356 @@
-//! Instruction counts of the model's hot paths, measured in QEMU (build feature `bench`).
+//! Instruction counts of every model variant and of the control step per fidelity level,
+//! measured in QEMU (build feature `bench`; `scripts/speed-table` runs it and feeds the output
+//! to `sonolube speed`).
 //!
-//! Each benchmark evaluates one call `CALLS` times over a fixed grid of inputs and divides the
-//! elapsed virtual time by the call count. Under `-icount shift=0` one guest instruction advances
-//! virtual time by 1 ns, and one 25 MHz SysTick cycle is 40 ns, so instructions per call =
-//! 40 x cycles / calls (resolution 40 / CALLS instructions). Inputs and results go through
-//! `black_box` so the compiler can neither hoist nor drop the call; the cost of making the
-//! inputs is measured alone and subtracted, but the call and the memory traffic `black_box`
-//! forces on its arguments and result (about 10-25 instructions) stay in the figure. Results
-//! print as `bench NAME: N instructions per call`.
+//! Method. Under `-icount shift=N` one guest instruction advances virtual time by 2^N ns, and
+//! one 25 MHz SysTick cycle is 40 ns, so a SysTick interval of c cycles is 40 c / 2^N
+//! instructions; the shift is read from the `icount=N` word `scripts/qemu-run` puts on the
+//! command line (without it the benchmark refuses to report: it cannot convert). The published
+//! counts use shift 0 (+-40 instructions per interval). Each variant is called on the same grid
+//! of inputs as its error is measured on (`sonolube::variant::grid`): a kernel on its own input
+//! grid, a model on the operating grid of every scene of its family that carries its
+//! parameters, built as that scene would build it.
+//! Inputs are prepared outside the timed loop, in chunks of up to [`BUFFER`]; each chunk is
+//! timed twice, calling the variant and doing the same loop without it, and the difference is
+//! summed over the chunks, so the figure is the call alone (call, return and the `black_box`
+//! traffic on its arguments and result, a few instructions, included). Every grid point is
+//! timed. Between chunks the watchdog is fed (the benchmark holds the executor for seconds of
+//! virtual time); chunks are sized from the dearest of a few probe calls to last about 1 ms of
+//! virtual time. The SysTick rounding (+-40 instructions at shift 0 per interval, two
+//! intervals per chunk) is at most 0.3 instructions per call for the cheap calls (256 per
+//! chunk) and below 0.1 % of the expensive ones.
+//!
+//! The control step is `sonolube::sim::ClosedLoop::control_phase` (target, sensing, estimate,
+//! model and its inverse, controller, drive command), timed around every step of a scene whose
+//! controller model is set to the fidelity level; the plant's phase is not timed.
+//!
+//! Output, one line per measurement (parsed by `sonolube speed`):
+//! `bench NAME: N.NNN instructions per call (C calls)`.
 
 use core::hint::black_box;
+use core::mem::MaybeUninit;
 
-use sonolube::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
-use sonolube::model::{FrictionModel, OperatingPoint};
-use sonolube::plant::AnyModel;
+use sonolube::fx::Q1_31;
+use sonolube::model::{FrictionModel, OperatingPoint, dahl, littmann};
+use sonolube::scene::{ModelKind, ModelSpec, SCENES, Scene};
+use sonolube::sim::ClosedLoop;
+use sonolube::variant::float_inplane::{dahl_update, littmann as float_littmann};
+use sonolube::variant::grid::{
+    DAHL_UPDATE_POINTS, DahlUpdateInput, LITTMANN_POINTS, SceneGrid, dahl_update_input,
+    littmann_input,
+};
+use sonolube::variant::model::FloatModel;
+use sonolube::variant::real::{Libm, Maths, Micromath, Real};
+use sonolube::variant::{CATALOGUE, CONTROL_STEPS, Family, Fidelity, Form, Model, Variant};
 
-use crate::time_driver;
+use crate::{time_driver, watchdog};
 
-/// Calls per benchmark.
-const CALLS: u32 = 2_000;
-/// Guest instructions per 25 MHz core cycle under `-icount shift=0`.
-const INSTRUCTIONS_PER_CYCLE: u64 = 40;
+/// Nanoseconds of virtual time per 25 MHz core cycle.
+const NS_PER_CYCLE: u64 = 40;
+/// Inputs prepared per chunk.
+const BUFFER: usize = 256;
+/// Core cycles (2 ms of virtual time, a small fraction of the watchdog's timeout) of which a
+/// timed chunk is sized to take half, the margin for calls dearer than the probes found.
+const CHUNK_CYCLES: u64 = 50_000;
+/// Single calls timed to size the chunks.
+const PROBES: usize = 9;
 
-/// Virtual-time cost of `CALLS` runs of `body(k)`, in instructions (x 1000 for 3 decimals).
-fn measure(mut body: impl FnMut(u32)) -> u64 {
-    let start = time_driver::cycles();
-    for k in 0..CALLS {
-        body(black_box(k));
+/// QEMU's `-icount` shift, from the `icount=N` word of the command line (semihosting
+/// `SYS_GET_CMDLINE`); `None` when absent or malformed.
+fn icount_shift() -> Option<u32> {
+    let mut buffer = [MaybeUninit::<u8>::uninit(); 256];
+    let bytes = semihosting::sys::arm_compat::sys_get_cmdline_uninit(&mut buffer).ok()?;
+    core::str::from_utf8(bytes)
+        .ok()?
+        .split_ascii_whitespace()
+        .find_map(|word| word.strip_prefix("icount="))
+        .and_then(|shift| shift.parse().ok())
+        .filter(|&shift| shift <= 10)
+}
+
+/// Thousandths of an instruction per call for `cycles` over `calls` at `-icount shift`.
+fn milli_instructions(cycles: i64, calls: u64, shift: u32) -> Option<u64> {
+    ((cycles.max(0) as u64 * NS_PER_CYCLE * 1000) >> shift).checked_div(calls)
+}
+
+/// Net cycles and calls of one variant.
+#[derive(Default)]
+struct Tally {
+    cycles: i64,
+    calls: u64,
+}
+
+impl Tally {
+    /// Prints `bench NAME: N.NNN instructions per call (C calls)`.
+    fn report(&self, name: &str, shift: u32) {
+        let Some(milli) = milli_instructions(self.cycles, self.calls, shift) else {
+            defmt::error!("bench {=str}: no calls", name);
+            return;
+        };
+        defmt::info!(
+            "bench {=str}: {=u64}.{=u64:03} instructions per call ({=u64} calls)",
+            name,
+            milli / 1000,
+            milli % 1000,
+            self.calls
+        );
     }
-    (time_driver::cycles() - start) * INSTRUCTIONS_PER_CYCLE * 1000 / u64::from(CALLS)
 }
 
-/// Measures `call` on the inputs `make(k)`, minus the cost of making the inputs alone, and
-/// prints the result.
-fn bench<I, O>(name: &str, make: impl Fn(u32) -> I, call: impl Fn(I) -> O) {
-    let inputs_only = measure(|k| {
-        black_box(make(k));
-    });
-    let with_call = measure(|k| {
-        black_box(call(black_box(make(k))));
-    });
-    let net = with_call.saturating_sub(inputs_only);
+/// Core cycles of calling `call` on every input of `inputs`.
+fn cycles_of<I: Copy, R>(inputs: &[I], call: &impl Fn(I) -> R) -> u64 {
+    let start = time_driver::cycles();
+    for &input in inputs {
+        black_box(call(black_box(input)));
+    }
+    time_driver::cycles().saturating_sub(start)
+}
+
+/// Times `call` on the inputs `make(i)`, i < `count`, adding the net cycles and the calls to
+/// `tally`.
+fn time<I: Copy, R>(
+    count: usize,
+    make: impl Fn(usize) -> I,
+    call: impl Fn(I) -> R,
+    tally: &mut Tally,
+) {
+    if count == 0 {
+        return;
+    }
+    let mut buffer = [make(0); BUFFER];
+    // The dearest of a few calls spread over the inputs, alone, sizes the chunks (a grid's
+    // costs vary: a Dahl steady state without velocity reversal returns at once).
+    let dearest = (0..PROBES)
+        .map(|k| cycles_of(&[make(k * (count - 1) / (PROBES - 1))], &call))
+        .max()
+        .unwrap_or(1);
+    watchdog::feed();
+    let chunk = (CHUNK_CYCLES / (2 * dearest).max(1)).clamp(1, BUFFER as u64) as usize;
+    let mut pending = (0..count).peekable();
+    while pending.peek().is_some() {
+        let mut filled = 0;
+        for (slot, index) in buffer.iter_mut().zip(pending.by_ref().take(chunk)) {
+            *slot = make(index);
+            filled += 1;
+        }
+        let with = cycles_of(&buffer[..filled], &call);
+        let without = cycles_of(&buffer[..filled], &|input: I| input);
+        tally.cycles += with as i64 - without as i64;
+        tally.calls += filled as u64;
+        watchdog::feed();
+    }
+}
+
+fn kernel(variant: &Variant, shift: u32) {
+    let mut tally = Tally::default();
+    let zeta = |i| littmann_input(i);
+    let zeta_f64 = |i| littmann_input(i).to_f64();
+    let update = |i| dahl_update_input(i);
+    let update_float = |i| {
+        let input = dahl_update_input(i);
+        (input.state.to_f64(), input.forward, input.travel.to_f64())
+    };
+    let (n, l) = (DAHL_UPDATE_POINTS, LITTMANN_POINTS);
+    match (variant.fidelity, variant.form) {
+        (Fidelity::Littmann, Form::Fixed) => time(l, zeta, littmann::mu_i::<30>, &mut tally),
+        (Fidelity::Littmann, Form::F32Micromath) => time(
+            l,
+            |i| zeta_f64(i) as f32,
+            float_littmann::<f32, Micromath>,
+            &mut tally,
+        ),
+        (Fidelity::Littmann, Form::F32Libm) => time(
+            l,
+            |i| zeta_f64(i) as f32,
+            float_littmann::<f32, Libm>,
+            &mut tally,
+        ),
+        (Fidelity::Littmann, Form::F64) => {
+            time(l, zeta_f64, float_littmann::<f64, Libm>, &mut tally)
+        }
+        (Fidelity::DahlUpdate, Form::Fixed) => time(
+            n,
+            update,
+            |u: DahlUpdateInput| dahl::update(u.state, u.forward, u.travel),
+            &mut tally,
+        ),
+        (Fidelity::DahlUpdate, Form::F32Micromath) => time(
+            n,
+            |i| {
+                let (f, forward, y) = update_float(i);
+                (f as f32, forward, y as f32)
+            },
+            |(f, forward, y)| dahl_update::<f32, Micromath>(f, forward, y),
+            &mut tally,
+        ),
+        (Fidelity::DahlUpdate, Form::F32Libm) => time(
+            n,
+            |i| {
+                let (f, forward, y) = update_float(i);
+                (f as f32, forward, y as f32)
+            },
+            |(f, forward, y)| dahl_update::<f32, Libm>(f, forward, y),
+            &mut tally,
+        ),
+        (Fidelity::DahlUpdate, Form::F64) => time(
+            n,
+            update_float,
+            |(f, forward, y)| dahl_update::<f64, Libm>(f, forward, y),
+            &mut tally,
+        ),
+        _ => return,
+    }
+    tally.report(variant.name, shift);
+}
+
+/// The family of a scene's operating grid.
+fn family(scene: &Scene<'_>) -> Family {
+    if scene.contents.normal_vibration {
+        Family::Cube
+    } else {
+        Family::InPlane
+    }
+}
+
+/// Times one float model on a scene's grid.
+fn float_model<T: Real, M: Maths<T>>(model: &FloatModel<T>, grid: &SceneGrid, tally: &mut Tally) {
+    let make = |i| {
+        let p = grid.at(i);
+        (
+            T::of(p.load_n()),
+            T::of(p.velocity_m_per_s()),
+            T::of(p.amplitude()),
+        )
+    };
+    let call = |(load, v, a): (T, T, T)| model.ratio::<M>(load, v, a);
+    time(grid.len(), make, call, tally);
+}
+
+/// Times a model-level variant over every scene of its family that can build it; false if a
+/// model that should build does not.
+fn model(variant: &Variant, shift: u32) -> bool {
+    let mut tally = Tally::default();
+    for scene in SCENES
+        .iter()
+        .filter(|s| family(s) == variant.fidelity.family())
+    {
+        if !sonolube::variant::fixed::buildable(scene, variant.fidelity) {
+            continue;
+        }
+        let built = match Model::new(scene, variant) {
+            Ok(model) => model,
+            Err(error) => {
+                defmt::error!(
+                    "bench {=str}: scene {=str}: {}",
+                    variant.name,
+                    scene.name,
+                    error
+                );
+                return false;
+            }
+        };
+        let grid = SceneGrid::new(scene);
+        match &built {
+            Model::Fixed(model) => {
+                let make = |i| {
+                    let p = grid.at(i);
+                    (p.point, p.amplitude)
+                };
+                let call =
+                    |(point, amplitude): (OperatingPoint, Q1_31)| model.ratio(&point, amplitude);
+                time(grid.len(), make, call, &mut tally);
+            }
+            Model::F32Micromath(model) => float_model::<f32, Micromath>(model, &grid, &mut tally),
+            Model::F32Libm(model) => float_model::<f32, Libm>(model, &grid, &mut tally),
+            Model::F64(model) => float_model::<f64, Libm>(model, &grid, &mut tally),
+        }
+    }
+    tally.report(variant.name, shift);
+    true
+}
+
+/// The controller model kind of a fidelity level.
+fn kind(fidelity: Fidelity) -> Option<ModelKind> {
+    match fidelity {
+        Fidelity::Coulomb => Some(ModelKind::Coulomb),
+        Fidelity::DahlSteady => Some(ModelKind::Dahl),
+        Fidelity::CubeElastic => Some(ModelKind::CubeElastic),
+        Fidelity::CubeElasticPlastic => Some(ModelKind::CubeElasticPlastic),
+        Fidelity::Littmann | Fidelity::DahlUpdate => None,
+    }
+}
+
+/// Times the control phase of `scene_name` run with a controller model of `fidelity`; false if
+/// the run cannot be built.
+fn control_step(name: &str, scene_name: &str, fidelity: Fidelity, shift: u32) -> bool {
+    let (Some(scene), Some(kind)) = (sonolube::scene::find(scene_name), kind(fidelity)) else {
+        defmt::error!("bench {=str}: no scene {=str}", name, scene_name);
+        return false;
+    };
+    let scene = Scene {
+        controller: ModelSpec {
+            kind,
+            ..scene.controller
+        },
+        ..*scene
+    };
+    let mut closed_loop = match ClosedLoop::new(&scene) {
+        Ok(run) => run,
+        Err(error) => {
+            defmt::error!("bench {=str}: {}", name, error);
+            return false;
+        }
+    };
+    let (mut tally, mut longest) = (Tally::default(), 0u64);
+    while !closed_loop.is_finished() {
+        if closed_loop.plant_phase().is_none() {
+            break;
+        }
+        watchdog::feed();
+        let start = time_driver::cycles();
+        let control = closed_loop.control_phase();
+        let cycles = time_driver::cycles().saturating_sub(start);
+        if control.is_none() || closed_loop.finish_step().is_none() {
+            break;
+        }
+        tally.cycles += cycles as i64;
+        tally.calls += 1;
+        longest = longest.max(cycles);
+    }
+    let Some(milli) = milli_instructions(tally.cycles, tally.calls, shift) else {
+        defmt::error!("bench {=str}: no steps", name);
+        return false;
+    };
     defmt::info!(
-        "bench {=str}: {=u64}.{=u64:03} instructions per call",
+        "bench {=str}: {=u64}.{=u64:03} instructions per call ({=u64} calls, longest {=u64})",
         name,
-        net / 1000,
-        net % 1000
-    );
-}
-
-/// Runs every benchmark; returns false if a model could not be built.
-pub fn run() -> bool {
-    let half = CALLS as i32 / 2;
-    // Littmann closed form over zeta in [-1, 1) (both branches of asin).
-    bench(
-        "Littmann closed form",
-        |k| Q2_30::from_bits((k as i32 - half) * ((1 << 30) / half)),
-        sonolube::model::littmann::mu_i,
-    );
-    // One exact Dahl update (alpha = 1) with a per-step travel kappa |dx| below 2.
-    bench(
-        "Dahl update",
-        |k| {
-            let f = Q2_30::from_bits((k as i32) << 18);
-            let travel = Q2_30::from_bits(((k as i32) & 0x3FF) << 19);
-            (f, k & 1 == 0, travel)
-        },
-        |(f, forward, travel)| sonolube::model::dahl::update(f, forward, travel),
-    );
-    // Cube reduction, elastic-plastic contact, 16-point quadrature: the load-ramp scene's plant
-    // model, at loads 40..240 N and amplitudes over the whole range.
-    let Some(scene) = sonolube::scene::builtin::find("load-ramp") else {
-        defmt::error!("bench: no load-ramp scene");
-        return false;
-    };
-    let Ok(cube) = AnyModel::new(scene, &scene.plant) else {
-        defmt::error!("bench: the load-ramp plant model cannot be built");
-        return false;
-    };
-    bench(
-        "cube ep N=16",
-        |k| {
-            let point = OperatingPoint {
-                normal_force: Q16_16::from_bits((40 + (k % 200) as i32) << 16),
-                sliding_velocity: Q8_24::from_bits(1 << 19),
-            };
-            let amplitude = Q1_31::from_bits((k.wrapping_mul(2_654_435_761) >> 1) as i32);
-            (point, amplitude)
-        },
-        |(point, amplitude)| cube.ratio(&point, amplitude),
+        milli / 1000,
+        milli % 1000,
+        tally.calls,
+        (longest * NS_PER_CYCLE) >> shift
     );
     true
+}
+
+/// Runs every benchmark; returns false if a model or a run could not be built, or if the
+/// `-icount` shift is unknown.
+pub fn run() -> bool {
+    let Some(shift) = icount_shift() else {
+        defmt::error!("bench: no icount=N on the command line: cycles cannot become instructions");
+        return false;
+    };
+    defmt::info!("bench: -icount shift={=u32}", shift);
+    let mut ok = true;
+    for variant in CATALOGUE {
+        watchdog::feed();
+        if variant.fidelity.family() == Family::Kernel {
+            kernel(variant, shift);
+        } else {
+            ok &= model(variant, shift);
+        }
+    }
+    for &(name, scene, fidelity) in CONTROL_STEPS {
+        ok &= control_step(name, scene, fidelity, shift);
+    }
+    ok
 }

@@ -27,6 +27,11 @@ const SUBCOMMANDS: &[Subcommand] = &[
         "run a scene closed loop: CSV, SVG and metrics",
         sonolube_host::cli::scene::run,
     ),
+    (
+        "speed",
+        "speed vs accuracy of every model variant (markdown, SVG, table)",
+        sonolube_host::cli::speed::run,
+    ),
 ];
 
 fn usage() -> String {

@@ -4,3 +4,4 @@ pub mod eval;
 pub mod monitor;
 pub mod papers;
 pub mod scene;
+pub mod speed;

@@ -1,0 +1,128 @@
+//! `sonolube speed`: the speed-versus-accuracy table (issue 7).
+//!
+//! ```text
+//! sonolube speed --qemu LOG [--root DIR]
+//! sonolube speed --check [--qemu LOG] [--root DIR]
+//! ```
+//!
+//! Reads the instruction counts from `LOG` (the decoded output of the QEMU benchmark build;
+//! `-` for stdin), measures the errors of every variant and their host times (release builds
+//! only: a debug build's timings mean nothing), and writes `docs/speed.md`, `docs/speed.svg`
+//! and `src/variant/table.rs` under `DIR` (default: the repository). `scripts/speed-table`
+//! builds and runs the benchmark firmware and calls this with its log.
+//!
+//! `--check` writes nothing and times nothing: it regenerates the files from the committed
+//! counts (`docs/speed-qemu.txt` unless `--qemu` is given) and the host ratios recorded in the
+//! committed `docs/speed.md`, and exits 1 when a committed file differs.
+//!
+//! Exit status: 0 done (or current), 1 a failed measurement or a stale file, 2 usage.
+
+use std::collections::BTreeMap;
+use std::io::Read as _;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use crate::speed::{self, MARKDOWN, QEMU_LOG, markdown, timing};
+
+const USAGE: &str = "usage: sonolube speed --qemu LOG [--root DIR]\n       sonolube speed --check [--qemu LOG] [--root DIR]\n";
+
+fn usage(message: &str) -> ExitCode {
+    eprint!("sonolube speed: {message}\n{USAGE}");
+    ExitCode::from(2)
+}
+
+fn read(path: &str) -> Result<String, String> {
+    if path == "-" {
+        let mut text = String::new();
+        std::io::stdin()
+            .read_to_string(&mut text)
+            .map_err(|e| format!("stdin: {e}"))?;
+        Ok(text)
+    } else {
+        std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))
+    }
+}
+
+/// Entry point: `args` are the arguments after `speed`.
+pub fn run(args: &[String]) -> ExitCode {
+    let (mut log, mut root, mut check) = (None, speed::repo_root(), false);
+    let mut rest = args.iter();
+    while let Some(arg) = rest.next() {
+        match arg.as_str() {
+            "--qemu" => match rest.next() {
+                Some(path) => log = Some(path.clone()),
+                None => return usage("--qemu needs a file"),
+            },
+            "--root" => match rest.next() {
+                Some(dir) => root = PathBuf::from(dir),
+                None => return usage("--root needs a directory"),
+            },
+            "--check" => check = true,
+            other => return usage(&format!("unknown argument {other:?}")),
+        }
+    }
+    let result = if check {
+        let log = log.unwrap_or_else(|| root.join(QEMU_LOG).to_string_lossy().into_owned());
+        run_check(&log, &root)
+    } else {
+        match log {
+            Some(log) => run_write(&log, &root),
+            None => return usage("--qemu LOG is required (or --check)"),
+        }
+    };
+    match result {
+        Ok(code) => code,
+        Err(message) => {
+            eprintln!("sonolube speed: {message}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn run_write(log: &str, root: &std::path::Path) -> Result<ExitCode, String> {
+    if cfg!(debug_assertions) {
+        return Err("host timings need a release build: cargo run --release ... -- speed".into());
+    }
+    let log_text = read(log)?;
+    speed::qemu::parse(&log_text)?; // fail before the long part
+    let ratios: BTreeMap<String, f64> = timing::measure()?
+        .into_iter()
+        .map(|(name, r)| (name.to_string(), r))
+        .collect();
+    let outputs = speed::generate(&log_text, &ratios)?;
+    for (path, contents) in outputs.files() {
+        let full = root.join(path);
+        if let Some(dir) = full.parent() {
+            std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        }
+        std::fs::write(&full, contents).map_err(|e| format!("{}: {e}", full.display()))?;
+        println!("wrote {}", full.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_check(log: &str, root: &std::path::Path) -> Result<ExitCode, String> {
+    let committed = std::fs::read_to_string(root.join(MARKDOWN))
+        .map_err(|e| format!("{}: {e}", root.join(MARKDOWN).display()))?;
+    let outputs = speed::generate(&read(log)?, &markdown::host_ratios(&committed))?;
+    let mut stale = Vec::new();
+    for (path, contents) in outputs.files() {
+        let on_disk = std::fs::read_to_string(root.join(path)).unwrap_or_default();
+        if on_disk != contents {
+            stale.push(path);
+        }
+    }
+    if stale.is_empty() {
+        println!(
+            "speed table current: {}",
+            outputs.files().map(|f| f.0).join(", ")
+        );
+        Ok(ExitCode::SUCCESS)
+    } else {
+        eprintln!(
+            "sonolube speed: stale: {} (run scripts/speed-table)",
+            stale.join(", ")
+        );
+        Ok(ExitCode::from(1))
+    }
+}

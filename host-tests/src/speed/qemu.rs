@@ -1,0 +1,138 @@
+//! The instruction counts of the QEMU benchmark build, read from its decoded log.
+//!
+//! The firmware prints one line per measurement (`board/qemu/src/bench.rs`):
+//! `bench NAME: N.NNN instructions per call (C calls[, longest L])`, after defmt-print's
+//! timestamp and level. Other lines are ignored. A name printed twice is an error, and so is a
+//! catalogued variant or control step without a count (the log is from another build).
+
+use std::collections::BTreeMap;
+
+use sonolube::variant::{CATALOGUE, CONTROL_STEPS};
+
+/// One measurement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Count {
+    /// Instructions per call (mean).
+    pub instructions: f64,
+    /// Calls (or control steps) measured.
+    pub calls: u64,
+    /// Longest single call, for the control steps.
+    pub longest: Option<u64>,
+}
+
+/// Counts by name.
+pub type Counts = BTreeMap<String, Count>;
+
+/// Parses one line; `None` when it is not a benchmark line.
+fn parse_line(line: &str) -> Option<Result<(String, Count), String>> {
+    let (_, rest) = line.split_once("bench ")?;
+    let (name, rest) = rest.split_once(": ")?;
+    let (number, rest) = rest.split_once(" instructions per call")?;
+    let parsed = (|| {
+        let instructions: f64 = number
+            .trim()
+            .parse()
+            .map_err(|_| format!("bad count {number:?}"))?;
+        let inside = rest
+            .trim()
+            .strip_prefix('(')
+            .and_then(|r| r.strip_suffix(')'))
+            .ok_or("no (C calls) after the count")?;
+        let mut parts = inside.split(", ");
+        let calls = parts
+            .next()
+            .and_then(|p| p.strip_suffix(" calls"))
+            .and_then(|c| c.parse().ok())
+            .ok_or("no call count")?;
+        let longest = match parts.next() {
+            Some(p) => Some(
+                p.strip_prefix("longest ")
+                    .and_then(|l| l.parse().ok())
+                    .ok_or("bad longest")?,
+            ),
+            None => None,
+        };
+        if !instructions.is_finite() || instructions <= 0.0 || calls == 0 {
+            return Err("count must be positive".to_string());
+        }
+        Ok(Count {
+            instructions,
+            calls,
+            longest,
+        })
+    })();
+    Some(
+        parsed
+            .map(|count| (name.to_string(), count))
+            .map_err(|e| format!("{line:?}: {e}")),
+    )
+}
+
+/// Every count of a log. Errors: a malformed benchmark line, a name twice, or a catalogued
+/// variant or control step missing.
+pub fn parse(log: &str) -> Result<Counts, String> {
+    let mut counts = Counts::new();
+    for line in log.lines() {
+        if let Some(parsed) = parse_line(line) {
+            let (name, count) = parsed?;
+            if counts.insert(name.clone(), count).is_some() {
+                return Err(format!("{name}: measured twice"));
+            }
+        }
+    }
+    let expected = CATALOGUE
+        .iter()
+        .map(|v| v.name)
+        .chain(CONTROL_STEPS.iter().map(|c| c.0));
+    let missing: Vec<&str> = expected.filter(|n| !counts.contains_key(*n)).collect();
+    if !missing.is_empty() {
+        return Err(format!(
+            "no instruction count for {} (a log of another build?)",
+            missing.join(", ")
+        ));
+    }
+    Ok(counts)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn full_log() -> String {
+        let mut log = String::from("0.000000 INFO  sonolube 0.1.0 on qemu\n");
+        for (i, v) in CATALOGUE.iter().enumerate() {
+            log.push_str(&format!(
+                "0.5{i:05} INFO  bench {}: {}.250 instructions per call (264 calls)\n",
+                v.name,
+                100 + i
+            ));
+        }
+        for (name, _, _) in CONTROL_STEPS {
+            log.push_str(&format!(
+                "1.0 INFO  bench {name}: 2764.320 instructions per call (250 calls, longest 3040)\n"
+            ));
+        }
+        log
+    }
+
+    #[test]
+    fn parses_every_line_and_requires_every_name() {
+        let counts = parse(&full_log()).unwrap();
+        assert_eq!(counts.len(), CATALOGUE.len() + CONTROL_STEPS.len());
+        let c = counts["cube ep N=16"];
+        assert_eq!(c.calls, 264);
+        assert!(c.instructions > 100.0 && c.longest.is_none());
+        let step = counts["control step"];
+        assert_eq!(
+            (step.instructions, step.calls, step.longest),
+            (2764.32, 250, Some(3040))
+        );
+        let missing = full_log().replace("bench cube ep N=16:", "bench other:");
+        assert!(parse(&missing).unwrap_err().contains("cube ep N=16"));
+        let twice = format!("{}{}", full_log(), full_log().lines().nth(1).unwrap());
+        assert!(parse(&twice).unwrap_err().contains("twice"));
+        let bad = full_log().replace("101.250 instructions", "x instructions");
+        assert!(parse(&bad).is_err());
+        assert!(parse("").is_err());
+    }
+}

@@ -1,0 +1,219 @@
+//! Building a variant's model for a scene: what the controller would run (fixed point, as
+//! [`crate::plant::AnyModel`]) and the parameters the float forms share with it.
+//!
+//! Every form takes the scene's *controller* parameters (its belief about mu, k_t and the
+//! surface: the mismatch with the plant is the feedback's business, not the model's) and the
+//! scene's hardware (drive frequency, full-scale amplitude, horn), with the project's default
+//! readings (seed 000's E* rule, the surfaces-apart slip window, an in-phase u). Only the
+//! fidelity level and the quadrature knob come from the variant, so a variant of another level
+//! than the scene's own controller model can be built whenever the controller spec carries its
+//! parameters (the scene schema allows a spec to carry parameters its kind does not use).
+
+use super::float_cube::FloatCubeParams;
+use super::{Fidelity, Variant};
+use crate::model::ModelError;
+use crate::model::contact::{ContactKind, ContactParams, EStarRule};
+use crate::model::coulomb::{CoulombConstants, CoulombModel};
+use crate::model::cube::{CubeOptions, CubeParams};
+use crate::model::cube_model::CubeModel;
+use crate::model::dahl::DahlParams;
+use crate::model::dahl_steady::DahlModel;
+use crate::model::horn::UPhase;
+use crate::model::quadrature::SlipWindow;
+use crate::plant::AnyModel;
+use crate::scene::{RoughSurface, Scene};
+
+/// What a scene's controller spec lacks for a fidelity level.
+fn missing(input: &'static str) -> ModelError {
+    ModelError::OutOfDomain {
+        input,
+        reason: "the scene's controller spec lacks what this fidelity needs",
+    }
+}
+
+/// Whether the scene's controller spec and hardware carry every parameter of `fidelity`
+/// (kernels need none).
+pub fn buildable(scene: &Scene<'_>, fidelity: Fidelity) -> bool {
+    match fidelity {
+        Fidelity::Littmann | Fidelity::DahlUpdate | Fidelity::Coulomb => true,
+        Fidelity::DahlSteady => scene.controller.k_t_n_per_m.is_some(),
+        Fidelity::CubeElastic | Fidelity::CubeElasticPlastic => {
+            scene.horn.is_some() && scene.controller.surface.is_some()
+        }
+    }
+}
+
+/// Dahl parameters of the scene's controller at `points` nodes per period.
+pub fn dahl_params(scene: &Scene<'_>, points: u32) -> Result<DahlParams, ModelError> {
+    let spec = &scene.controller;
+    Ok(DahlParams {
+        friction_coefficient: spec.mu,
+        tangential_stiffness: spec.k_t_n_per_m.ok_or(missing("k_t"))?,
+        frequency_hz: scene.transducer.drive_hz,
+        full_scale_amplitude_m: scene.actuator.full_scale_amplitude_m,
+        shape_exponent: spec.dahl_alpha.unwrap_or(1.0),
+        quadrature_points: points,
+    })
+}
+
+/// The contact parameters of a scene's rough surface (same fields, the model's names).
+pub fn contact_params(surface: &RoughSurface) -> ContactParams {
+    ContactParams {
+        roughness_rq: surface.rq_m,
+        summit_radius: surface.rs_m,
+        nominal_area: surface.nominal_area_m2,
+        asperity_density: surface.asperity_density_per_m2,
+        distribution_c: surface.distribution_c,
+        distribution_lambda: surface.distribution_lambda,
+        young_1: surface.young_1_pa,
+        poisson_1: surface.poisson_1,
+        young_2: surface.young_2_pa,
+        poisson_2: surface.poisson_2,
+        poisson_soft: surface.poisson_soft,
+        yield_strength: surface.yield_strength_pa,
+    }
+}
+
+/// The contact model of a cube fidelity (elastic-plastic for anything else).
+pub fn contact_kind(fidelity: Fidelity) -> ContactKind {
+    if fidelity == Fidelity::CubeElastic {
+        ContactKind::Elastic
+    } else {
+        ContactKind::ElasticPlastic
+    }
+}
+
+/// Cube parameters of the scene's controller and horn, for `fidelity`'s contact, N points.
+pub fn cube_params(
+    scene: &Scene<'_>,
+    fidelity: Fidelity,
+    points: usize,
+) -> Result<FloatCubeParams, ModelError> {
+    let horn = scene.horn.ok_or(missing("horn"))?;
+    let surface = scene.controller.surface.ok_or(missing("surface"))?;
+    Ok(FloatCubeParams {
+        contact: contact_params(&surface),
+        contact_kind: contact_kind(fidelity),
+        friction_coefficient: scene.controller.mu,
+        longitudinal_amplitude: scene.actuator.full_scale_amplitude_m,
+        vertical_amplitude: horn.vertical_amplitude_m,
+        position: horn.contact_position_m,
+        horn_length: horn.length_m,
+        points,
+    })
+}
+
+/// The fixed-point model of a model-level `variant` (Coulomb, Dahl steady, cube) for `scene`,
+/// as the controller runs it. Errors: a kernel variant (`OutOfDomain` on "variant"), the
+/// spec lacking the level's parameters, or the model's own validation.
+pub fn fixed_model(scene: &Scene<'_>, variant: &Variant) -> Result<AnyModel, ModelError> {
+    let frequency_hz = scene.transducer.drive_hz;
+    let amplitude_m = scene.actuator.full_scale_amplitude_m;
+    match variant.fidelity {
+        Fidelity::Littmann | Fidelity::DahlUpdate => Err(ModelError::OutOfDomain {
+            input: "variant",
+            reason: "a kernel, not a friction model",
+        }),
+        Fidelity::Coulomb => Ok(AnyModel::Coulomb(CoulombModel {
+            constants: CoulombConstants::new(scene.controller.mu, frequency_hz, amplitude_m)?,
+        })),
+        Fidelity::DahlSteady => Ok(AnyModel::Dahl(DahlModel::new(&dahl_params(
+            scene,
+            u32::from(variant.points),
+        )?)?)),
+        Fidelity::CubeElastic | Fidelity::CubeElasticPlastic => {
+            let p = cube_params(scene, variant.fidelity, usize::from(variant.points))?;
+            let params = CubeParams {
+                contact: p.contact,
+                friction_coefficient: p.friction_coefficient,
+                longitudinal_amplitude: p.longitudinal_amplitude,
+                vertical_amplitude: p.vertical_amplitude,
+                position: p.position,
+                horn_length: p.horn_length,
+                frequency: frequency_hz,
+            };
+            let options = CubeOptions {
+                e_star_rule: EStarRule::Seed000,
+                contact_kind: p.contact_kind,
+                window: SlipWindow::SurfacesApart,
+                u_phase: UPhase::InPhase,
+                quadrature_points: p.points,
+            };
+            Ok(AnyModel::Cube(CubeModel::new(&params, &options)?))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
+    use crate::model::{FrictionModel, OperatingPoint};
+    use crate::scene::{ModelKind, ModelSpec, find};
+    use crate::variant::find as variant;
+
+    fn point(load: f64, v: f64) -> OperatingPoint {
+        OperatingPoint {
+            normal_force: Q16_16::from_f64(load).unwrap(),
+            sliding_velocity: Q8_24::from_f64(v).unwrap(),
+        }
+    }
+
+    /// At the scene's own kind and the default knobs, the variant's model is exactly the one
+    /// `AnyModel::new` builds for the controller.
+    #[test]
+    fn default_knobs_give_the_controllers_own_model() {
+        let reference = find("reference").unwrap();
+        let own = AnyModel::new(reference, &reference.controller).unwrap();
+        let built = fixed_model(reference, variant("Coulomb ratio").unwrap()).unwrap();
+        assert_eq!(own, built);
+        let horn = find("load-ramp").unwrap();
+        let own = AnyModel::new(horn, &horn.controller).unwrap();
+        assert_eq!(
+            own,
+            fixed_model(horn, variant("cube el N=16").unwrap()).unwrap()
+        );
+        let dahl_scene = Scene {
+            controller: ModelSpec {
+                kind: ModelKind::Dahl,
+                ..reference.controller
+            },
+            ..*reference
+        };
+        let own = AnyModel::new(&dahl_scene, &dahl_scene.controller).unwrap();
+        assert_eq!(
+            own,
+            fixed_model(reference, variant("Dahl steady N=64").unwrap()).unwrap()
+        );
+    }
+
+    #[test]
+    fn knobs_and_levels_change_the_model_and_missing_parameters_are_errors() {
+        let horn = find("load-ramp").unwrap();
+        let at = point(40.0, 0.005);
+        let full = Q1_31::MAX;
+        let ep16 = fixed_model(horn, variant("cube ep N=16").unwrap()).unwrap();
+        let ep4 = fixed_model(horn, variant("cube ep N=4").unwrap()).unwrap();
+        let el16 = fixed_model(horn, variant("cube el N=16").unwrap()).unwrap();
+        let (r16, r4, el) = (
+            ep16.ratio(&at, full).unwrap(),
+            ep4.ratio(&at, full).unwrap(),
+            el16.ratio(&at, full).unwrap(),
+        );
+        assert!((r16.to_f64() - 0.4806).abs() < 1e-3, "{r16:?}");
+        assert_ne!(r16, r4);
+        assert!(el > r16, "elastic {el:?} vs elastic-plastic {r16:?}");
+        assert!(fixed_model(horn, variant("Littmann closed form").unwrap()).is_err());
+        let beam = find("beam-table").unwrap();
+        assert!(!buildable(beam, Fidelity::DahlSteady));
+        assert!(fixed_model(beam, variant("Dahl steady N=16").unwrap()).is_err());
+        assert!(!buildable(beam, Fidelity::CubeElasticPlastic));
+        assert!(fixed_model(beam, variant("cube ep N=16").unwrap()).is_err());
+        assert_eq!(
+            fixed_model(beam, variant("Coulomb ratio").unwrap())
+                .unwrap()
+                .ratio(&point(15.0, 0.09), Q1_31::ZERO),
+            Ok(Q2_30::ONE)
+        );
+    }
+}

@@ -1,0 +1,249 @@
+//! Tests of the selection rules on measurements made up for each case (the committed table's
+//! own choices are checked on the host, `host-tests/tests/speed.rs`, against re-measured
+//! errors).
+
+use super::*;
+use crate::scene::{ModelSpec, find};
+
+fn leak<T>(items: Vec<T>) -> &'static [T] {
+    Box::leak(items.into_boxed_slice())
+}
+
+/// Measurements with `costs` (variant, instructions) and `errors` (scene, variant, reference,
+/// max error as a fraction).
+fn measured(
+    costs: &[(&'static str, f32)],
+    errors: &[(&'static str, &'static str, Fidelity, f32)],
+) -> Measurements {
+    Measurements {
+        costs: leak(
+            costs
+                .iter()
+                .map(|&(variant, instructions)| Cost {
+                    variant,
+                    instructions,
+                })
+                .collect(),
+        ),
+        errors: leak(
+            errors
+                .iter()
+                .map(|&(scene, variant, reference, max_error)| SceneError {
+                    scene,
+                    variant,
+                    reference,
+                    max_error,
+                    points: 120,
+                })
+                .collect(),
+        ),
+    }
+}
+
+const EP: Fidelity = Fidelity::CubeElasticPlastic;
+
+fn cube_costs() -> Vec<(&'static str, f32)> {
+    vec![
+        ("cube el N=4", 400.0),
+        ("cube el N=8", 700.0),
+        ("cube ep N=4", 400.0),
+        ("cube ep N=8", 700.0),
+        ("cube ep N=16", 1400.0),
+    ]
+}
+
+#[test]
+fn elastic_contact_within_budget_skips_the_plastic_terms() {
+    // load-ramp: budget 0.5 %. The elastic contact meets it at N = 8 (0.3 %), the
+    // elastic-plastic one at N = 8 too (0.01 %): equal cost, fewer parts wins.
+    let m = measured(
+        &cube_costs(),
+        &[
+            ("load-ramp", "cube el N=4", EP, 0.02),
+            ("load-ramp", "cube el N=8", EP, 0.003),
+            ("load-ramp", "cube ep N=4", EP, 0.01),
+            ("load-ramp", "cube ep N=8", EP, 0.0001),
+            ("load-ramp", "cube ep N=16", EP, 0.000_01),
+        ],
+    );
+    let scene = find("load-ramp").unwrap();
+    let s = select_from(scene, &m);
+    assert_eq!(s.variant.map(|v| v.name), Some("cube el N=8"));
+    assert_eq!(s.required, Some(EP));
+    assert!(matches!(s.reason, Reason::Meets { candidates: 5, .. }));
+    let Some(Parts::Cube { plastic, .. }) = s.parts else {
+        panic!("{s:?}");
+    };
+    assert!(plastic.skipped);
+    assert!((plastic.error_pct.unwrap() - 0.3).abs() < 1e-4);
+    let line = std::format!("{s}");
+    assert!(
+        line.contains("cube el N=8") && line.contains("plastic terms skipped"),
+        "{line}"
+    );
+    assert!(!line.contains('\n'));
+    assert_eq!(s.build(scene).unwrap().kind(), ModelKind::CubeElastic);
+}
+
+#[test]
+fn elastic_contact_beyond_budget_keeps_the_plastic_terms() {
+    let m = measured(
+        &cube_costs(),
+        &[
+            ("load-ramp", "cube el N=4", EP, 0.03),
+            ("load-ramp", "cube el N=8", EP, 0.017),
+            ("load-ramp", "cube ep N=4", EP, 0.01),
+            ("load-ramp", "cube ep N=8", EP, 0.001),
+            ("load-ramp", "cube ep N=16", EP, 0.000_01),
+        ],
+    );
+    let scene = find("load-ramp").unwrap();
+    let s = select_from(scene, &m);
+    // ep N=8 (0.1 %) is the cheapest within 0.5 %; N=16 is more accurate but dearer.
+    assert_eq!(s.variant.map(|v| v.name), Some("cube ep N=8"));
+    let Some(Parts::Cube {
+        plastic,
+        load_range_n,
+    }) = s.parts
+    else {
+        panic!("{s:?}");
+    };
+    assert!(!plastic.skipped);
+    assert!((plastic.error_pct.unwrap() - 1.7).abs() < 1e-4);
+    assert_eq!(load_range_n, (40.0, 240.0));
+    let line = std::format!("{s}");
+    assert!(
+        line.contains("plastic terms kept") && line.contains("over 40 to 240 N"),
+        "{line}"
+    );
+    let model = s.build(scene).unwrap();
+    assert_eq!(model.kind(), ModelKind::CubeElasticPlastic);
+}
+
+#[test]
+fn when_nothing_meets_the_budget_the_most_accurate_required_level_is_taken() {
+    let m = measured(
+        &cube_costs(),
+        &[
+            ("load-ramp", "cube el N=8", EP, 0.0001), // must not win: not the required level
+            ("load-ramp", "cube ep N=4", EP, 0.02),
+            ("load-ramp", "cube ep N=16", EP, 0.008),
+        ],
+    );
+    // A budget of 0.001 % that no variant meets.
+    let base = find("load-ramp").unwrap();
+    let tight = Scene {
+        accuracy: crate::scene::Accuracy {
+            model_pct: 0.001,
+            ..base.accuracy
+        },
+        ..*base
+    };
+    let s = select_from(&tight, &m);
+    assert_eq!(s.variant.map(|v| v.name), Some("cube ep N=16"));
+    assert!(matches!(s.reason, Reason::NoneMeets { .. }), "{s:?}");
+    assert!(std::format!("{s}").contains("NO variant meets the budget"));
+}
+
+#[test]
+fn in_plane_scenes_use_the_in_plane_family_and_may_skip_the_compliance() {
+    let costs = vec![
+        ("Coulomb ratio", 400.0),
+        ("Dahl steady N=16", 12_000.0),
+        ("Dahl steady N=64", 49_000.0),
+        // A cube variant must never be a candidate for a scene without normal vibration.
+        ("cube ep N=4", 10.0),
+    ];
+    let reference = find("reference").unwrap();
+    let m = measured(
+        &costs,
+        &[
+            ("reference", "Coulomb ratio", Fidelity::Coulomb, 1e-9),
+            ("reference", "cube ep N=4", Fidelity::Coulomb, 0.0),
+        ],
+    );
+    let s = select_from(reference, &m);
+    assert_eq!(s.variant.map(|v| v.name), Some("Coulomb ratio"));
+    assert_eq!(s.parts, Some(Parts::InPlane { compliance: None }));
+    assert!(std::format!("{s}").contains("contact not re-evaluated"));
+
+    // The same scene asking for the Dahl model: Coulomb is within 0.25 % -> compliance skipped;
+    // then not -> the cheapest Dahl within budget.
+    let dahl = Scene {
+        controller: ModelSpec {
+            kind: ModelKind::Dahl,
+            ..reference.controller
+        },
+        ..*reference
+    };
+    let d = Fidelity::DahlSteady;
+    let near = measured(
+        &costs,
+        &[
+            ("reference", "Coulomb ratio", d, 0.002),
+            ("reference", "Dahl steady N=16", d, 0.001),
+            ("reference", "Dahl steady N=64", d, 0.0001),
+        ],
+    );
+    let s = select_from(&dahl, &near);
+    assert_eq!(s.variant.map(|v| v.name), Some("Coulomb ratio"));
+    assert!(matches!(
+        s.parts,
+        Some(Parts::InPlane {
+            compliance: Some(Reduction { skipped: true, .. })
+        })
+    ));
+    let far = measured(
+        &costs,
+        &[
+            ("reference", "Coulomb ratio", d, 0.05),
+            ("reference", "Dahl steady N=16", d, 0.001),
+            ("reference", "Dahl steady N=64", d, 0.0001),
+        ],
+    );
+    let s = select_from(&dahl, &far);
+    assert_eq!(s.variant.map(|v| v.name), Some("Dahl steady N=16"));
+    assert!(std::format!("{s}").contains("Dahl compliance kept (Coulomb ratio: 5.000 %)"));
+    assert_eq!(s.build(&dahl).unwrap().kind(), ModelKind::Dahl);
+}
+
+#[test]
+fn unmeasured_scenes_keep_their_own_model() {
+    let m = measured(&cube_costs(), &[("load-ramp", "cube ep N=4", EP, 0.0)]);
+    let other = find("horn-al-ss").unwrap();
+    let s = select_from(other, &m);
+    assert_eq!(s.variant, None);
+    assert_eq!(
+        s.reason,
+        Reason::NotMeasured {
+            kind: ModelKind::CubeElastic
+        }
+    );
+    let own = AnyModel::new(other, &other.controller).unwrap();
+    assert_eq!(s.build(other).unwrap(), own);
+    assert!(std::format!("{s}").contains("not in the measured table"));
+    // A scene whose controller model is outside the catalogue (exponential Coulomb law).
+    let beam = find("beam-table").unwrap();
+    let exp = Scene {
+        controller: beam.plant,
+        ..*beam
+    };
+    assert_eq!(required_fidelity(&exp), None);
+    assert_eq!(select(&exp).variant, None);
+}
+
+#[test]
+fn the_committed_table_gives_every_builtin_scene_a_buildable_measured_choice() {
+    for scene in crate::scene::SCENES {
+        let s = select(scene);
+        let variant = s.variant.unwrap_or_else(|| panic!("{}: {s}", scene.name));
+        assert_eq!(variant.form, Form::Fixed);
+        assert!(s.build(scene).is_ok(), "{}", scene.name);
+        let family = if scene.contents.normal_vibration {
+            Family::Cube
+        } else {
+            Family::InPlane
+        };
+        assert_eq!(variant.fidelity.family(), family, "{}", scene.name);
+    }
+}
