@@ -41,7 +41,7 @@
 //! |-------------------------------|---------------------------|----------------------|--------|
 //! | [`Q::sqrt`], [`Q::sqrt_to`]   | `Q<F>` >= 0 -> `Q<OUT>`   | 0.5 ulp (exact)      | ~95    |
 //! | [`isqrt_u64`]                 | `u64` -> `u32`            | exact floor          | ~75    |
-//! | [`Q::exp_neg`]                | `Q<F>` >= 0 -> Q2.30      | 0.75 ulp (7e-10)     | ~45    |
+//! | [`Q::exp_neg`]                | `Q<F>` >= 0 -> Q2.30      | 0.75 ulp (7e-10)     | < 44   |
 //! | [`Q::exp`]                    | `Q<F>` -> `Q<OUT>`        | 1 ulp or 1.5e-9 rel. | ~55    |
 //! | [`Q::ln`], [`ln_scaled`]      | > 0 -> `Q<OUT>`           | 0.5 ulp + 8e-10      | ~55    |
 //! | [`Q2_30::asin`](Q::asin)      | Q2.30 in [-1, 1] -> Q2.30 | 1 ulp, 1e-6 rel.     | 65/115 |
@@ -49,13 +49,14 @@
 //! | `checked_mul(_to)`, `lerp`    |                           | 0.5 ulp              | 10-20  |
 //! | `checked_div(_to)`            |                           | 0.5 ulp              | ~200   |
 //!
-//! (asin: |z| <= 1/2 / |z| > 1/2, which needs a square root; sin / sin_cos.)
+//! (asin: |z| <= 1/2 / |z| > 1/2, which needs a square root; sin / sin_cos. `exp_neg`: below
+//! the Dahl update's 44 instructions, which call it once.)
 //!
 //! # For the model code
 //!
 //! - Littmann law (physics-notes §1): `zeta: Q2_30 = v_s.checked_div_to(v_a)?` (precompute
-//!   `1/v_a` when it changes to avoid the division), handle |zeta| >= 1 first, then
-//!   `zeta.asin()?.checked_mul(Q2_30::FRAC_2_PI)?`.
+//!   `1/v_a` when it changes to avoid the division), handle |zeta| >= 1 first, then the
+//!   (2/pi) asin with the gain folded in (`littmann::mu_i`, 45 instructions).
 //! - Dahl update (§2): carry `f` in Q2.30 (exact +-1), `decay = kappa_dx.exp_neg()?` with
 //!   `kappa |dx|` in the finest format that holds it (Q2.30 below 2, Q8.24 below 128), then
 //!   `f = s.lerp(f, decay)?`, which stays in [-1, 1] by construction.

@@ -12,13 +12,17 @@
 //!
 //! | call | instructions |
 //! |---|---|
-//! | [`super::littmann::mu_i`], \|zeta\| in [0, 1/2] / (1/2, 1) / [1, inf) | 61 / 107 / 14 |
-//! | [`super::dahl::update`] (exact, alpha = 1), Q2.30 / Q8.24 travel | 59 / 57 |
+//! | [`super::littmann::mu_i`], mean over zeta in [-1, 1) (bench build, `docs/speed.md`) | 45 |
+//! | [`super::dahl::update`] (exact, alpha = 1), Q2.30 travel (bench build, `docs/speed.md`) | 44 |
 //! | [`super::wide::recip`] | 69 |
 //! | [`CoulombModel`] `ratio` (v / v_a included) / closed-form `invert` | 360-410 / 810-850 |
 //! | [`super::exp_coulomb::ExpCoulombConstants::friction`] | 206 |
 //! | actuator stroke + current + voltage limit | 306 |
 //! | [`super::dahl_steady::DahlModel`] `ratio`, N = 64 / N = 32 | 49k / 26k |
+//!
+//! The rows other than the first two were traced before `exp_neg` and the Littmann law were
+//! made faster; `scripts/speed-table` measures the current costs of every variant
+//! (`docs/speed.md`: Coulomb ratio 287, Dahl steady N = 64 37,608).
 //!
 //! The first two are the hot-path goals (80 and 60): `mu_i` meets it except on
 //! 1/2 < |zeta| < 1, where `fx`'s `asin` takes its half-angle branch and a square root.
