@@ -10,6 +10,7 @@
 //! overflow is counted in [`link::LOST`].
 
 use embassy_futures::select::{Either, select};
+use embassy_futures::yield_now;
 use embedded_io_async::{Read, Write};
 use heapless::String;
 use sonolube::protocol::{
@@ -47,6 +48,10 @@ pub async fn serve<R: Read, W: Write>(mut rx: R, mut tx: W, identity: &Identity)
     let mut received = [0u8; 64];
     let mut out: String<LINE_CAPACITY> = String::new();
     loop {
+        // Let the other thread-mode tasks (the watchdog keeper among them) run first: while
+        // input keeps arriving and the UART keeps taking bytes, no await below is ever pending,
+        // and the executor would poll this task alone.
+        yield_now().await;
         let count = match select(rx.read(&mut received), TELEMETRY.receive()).await {
             Either::First(Ok(count)) => count,
             Either::First(Err(_)) => {

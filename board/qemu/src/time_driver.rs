@@ -101,12 +101,15 @@ impl Clock {
     fn arm(&mut self, cycles: u32) {
         let cycles = cycles.clamp(MIN_COUNTDOWN, MAX_COUNTDOWN);
         let now = self.elapsed_cycles();
-        // SAFETY: inside the caller's critical section; the ended countdown (if any) is already
-        // counted in `now`, so its pending interrupt is dropped.
+        // SAFETY: inside the caller's critical section. Restart first, then drop the pending
+        // interrupt: a countdown that ends between the read above and the restart (its last
+        // cycles are already counted in `now`, up to the few cycles of this sequence) must not
+        // leave its interrupt pending, or `on_interrupt` would count the new countdown as
+        // ended and the clock would jump ahead by its length (up to 2^24 cycles).
         unsafe {
-            (*SCB::PTR).icsr.write(ICSR_PENDSTCLR);
             syst().rvr.write(cycles - 1);
             syst().cvr.write(0);
+            (*SCB::PTR).icsr.write(ICSR_PENDSTCLR);
         }
         self.base = now;
         self.reload = cycles - 1;
