@@ -2,6 +2,14 @@
 //! controller and its friction model, the drive frequency, and the loop's share of the command
 //! protocol.
 //!
+//! The controller's model is the scene's model variant chosen by
+//! [`crate::variant::select`] (the cheapest fixed-point variant whose measured maximum error over
+//! the scene's range meets `accuracy.model_pct`, with the parts the scene does not need left
+//! out; a scene outside the committed table keeps its own model). This is the one place where
+//! the host (`sonolube scene`, [`crate::sim::ClosedLoop`]) and every board build a scene's
+//! controller, so they run the same variant; [`Station::selection`] says which and why, for the
+//! line printed at scene start.
+//!
 //! A board feeds it the converter codes of each period ([`Station::control`]) and applies the
 //! returned drive amplitude; between two periods it hands it the commands that change the loop
 //! ([`Station::execute`]): a command is applied whole or refused with the protocol error, never
@@ -24,6 +32,7 @@ use crate::protocol::{Axis, Command, ProtocolError, SupervisorState, TareAxes, T
 use crate::scene::Scene;
 use crate::sense::{SampleError, SensorChannel};
 use crate::sim::{COMMISSIONING_SAMPLES, SimError, controller_settings, sensor_channel};
+use crate::variant::{Selection, select};
 
 /// What a board gives the station each period.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -63,6 +72,8 @@ const FREQ_RANGE_CHZ: core::ops::RangeInclusive<u32> = 2_000_000..=6_000_000;
 #[derive(Debug, Clone)]
 pub struct Station {
     model: AnyModel,
+    /// The choice `model` was built from; `None` when the caller gave the model.
+    selection: Option<Selection>,
     controller: Controller,
     normal: SensorChannel,
     tangential: SensorChannel,
@@ -72,13 +83,36 @@ pub struct Station {
 }
 
 impl Station {
-    /// The station of `scene`: its controller model, the controller with `settings`, the
-    /// cells with their datasheet calibration, the scene's drive frequency, idle, no target.
+    /// The station of `scene`: the controller model [`select`] chooses for it (built with
+    /// [`Selection::build`]), the controller with `settings`, the cells with their datasheet
+    /// calibration, the scene's drive frequency, idle, no target. Errors: the model, the
+    /// settings or a cell refused.
     pub fn new(scene: &Scene<'_>, settings: &Settings) -> Result<Self, SimError> {
-        let model = AnyModel::new(scene, &scene.controller).map_err(SimError::Model)?;
+        let selection = select(scene);
+        let model = selection.build(scene).map_err(SimError::Model)?;
+        Self::assemble(scene, settings, model, Some(selection))
+    }
+
+    /// [`Station::new`] with the controller running `model` instead of the selected variant
+    /// (a benchmark timing one fidelity level; [`Station::selection`] is then `None`).
+    pub fn with_model(
+        scene: &Scene<'_>,
+        settings: &Settings,
+        model: AnyModel,
+    ) -> Result<Self, SimError> {
+        Self::assemble(scene, settings, model, None)
+    }
+
+    fn assemble(
+        scene: &Scene<'_>,
+        settings: &Settings,
+        model: AnyModel,
+        selection: Option<Selection>,
+    ) -> Result<Self, SimError> {
         let controller = Controller::new(Config::new(settings).map_err(SimError::Config)?);
         Ok(Self {
             model,
+            selection,
             controller,
             normal: sensor_channel(&scene.normal_cell)?,
             tangential: sensor_channel(&scene.tangential_cell)?,
@@ -229,6 +263,17 @@ impl Station {
     /// The drive frequency in cHz (0.01 Hz), as the protocol reports it.
     pub fn drive_freq_chz(&self) -> u32 {
         self.drive_freq_chz
+    }
+
+    /// The model variant the controller runs and why ([`select`]); `None` when the model was
+    /// given ([`Station::with_model`]).
+    pub fn selection(&self) -> Option<&Selection> {
+        self.selection.as_ref()
+    }
+
+    /// The controller's friction model.
+    pub fn model(&self) -> &AnyModel {
+        &self.model
     }
 
     /// The controller.

@@ -9,7 +9,8 @@ use std::process::Command;
 use sonolube::protocol::SupervisorState;
 use sonolube::scene::{SCENES, Scene, find};
 use sonolube::sim::{ClosedLoop, Measured, RunSummary, StepRecord};
-use sonolube_host::cli::scene::run_one;
+use sonolube::variant::{Reason, select};
+use sonolube_host::cli::scene::{model_line, model_name, run_one};
 
 fn run(scene: &Scene<'_>) -> (Vec<StepRecord>, RunSummary) {
     let mut sim = ClosedLoop::new(scene).unwrap_or_else(|e| panic!("{}: {e:?}", scene.name));
@@ -225,8 +226,8 @@ fn a_run_and_its_files_are_the_same_every_time() {
         assert_eq!(a.drive_amplitude.to_bits(), b.drive_amplitude.to_bits());
     }
     let (one, two) = (scratch_dir("determinism-1"), scratch_dir("determinism-2"));
-    let (_, report_one) = run_one(scene, &one).expect("writes");
-    let (_, report_two) = run_one(scene, &two).expect("writes");
+    let report_one = run_one(scene, &one).expect("writes").report;
+    let report_two = run_one(scene, &two).expect("writes").report;
     let strip = |text: &str| -> String {
         text.lines()
             .filter(|l| !l.contains("wrote"))
@@ -270,6 +271,12 @@ fn the_command_line_reports_and_exits_as_documented() {
     let text = String::from_utf8_lossy(&one.stdout);
     assert_eq!(one.status.code(), Some(0), "{text}");
     assert!(text.contains("PASS settle to ±2 % within 3 ms"), "{text}");
+    let reference = find("reference").expect("built in");
+    let station_line = model_line(ClosedLoop::new(reference).expect("runs").station());
+    assert!(
+        text.lines().take(3).any(|l| l.trim() == station_line),
+        "{station_line} not in the header of {text}"
+    );
     assert!(out.join("reference.csv").is_file() && out.join("reference.svg").is_file());
     let file = sonolube_host::scene_file::scenes_dir().join("sensor-fault.toml");
     let from_file = scene(&["--file", file.to_str().expect("utf-8"), "--out", out_dir]);
@@ -288,7 +295,76 @@ fn the_command_line_reports_and_exits_as_documented() {
         lines.last().copied(),
         Some(format!("{passed} passed, {failed} failed").as_str())
     );
+    // Each line ends with the model the scene's controller ran, the variant `select` names.
+    for (line, built) in lines.iter().zip(SCENES) {
+        let variant = select(built).variant.expect(built.name);
+        assert!(
+            line.ends_with(&format!("; model {}", variant.name)),
+            "{line}"
+        );
+    }
     assert_eq!(all.status.code(), Some(if failed == 0 { 0 } else { 1 }));
     let again = scene(&["--all", "--out", out_dir]);
     assert_eq!(again.stdout, all.stdout);
+}
+
+/// The line printed at scene start names the variant the controller runs and carries the
+/// reason's numbers (error, budget, instructions, grid points) and the parts kept or skipped.
+#[test]
+fn the_model_line_names_the_selected_variant_and_its_reason() {
+    for built in SCENES {
+        let selection = select(built);
+        let run = ClosedLoop::new(built).unwrap_or_else(|e| panic!("{}: {e:?}", built.name));
+        let line = model_line(run.station());
+        let variant = selection.variant.expect(built.name);
+        assert!(
+            line.starts_with(&format!("controller model {}: ", variant.name)),
+            "{line}"
+        );
+        assert_eq!(model_name(run.station()), format!("model {}", variant.name));
+        let numbers = match selection.reason {
+            Reason::Meets {
+                error_pct,
+                budget_pct,
+                instructions,
+                points,
+                candidates,
+            } => vec![
+                format!("within budget of {candidates} measured"),
+                format!("{instructions:.0} instructions"),
+                format!("max error {error_pct:.2e} % <= {budget_pct} %"),
+                format!("over {points} points"),
+            ],
+            Reason::NoneMeets {
+                error_pct,
+                budget_pct,
+                instructions,
+                points,
+            } => vec![
+                format!("NO variant meets the budget {budget_pct} %"),
+                format!("{instructions:.0} instructions"),
+                format!("max error {error_pct:.2e} %"),
+                format!("over {points} points"),
+            ],
+            Reason::NotMeasured { .. } => panic!("{}: built-in scenes are measured", built.name),
+        };
+        for number in numbers {
+            assert!(line.contains(&number), "{number:?} not in {line}");
+        }
+        let parts = selection.parts.expect(built.name);
+        assert!(line.ends_with(&format!("; {parts}")), "{line}");
+    }
+    // A scene outside the table: its own model, and the line says it was not measured.
+    let horn = find("horn-al-ss").expect("built in");
+    let renamed = Scene {
+        name: "my-horn",
+        ..*horn
+    };
+    let run = ClosedLoop::new(&renamed).expect("runs");
+    let line = model_line(run.station());
+    assert!(
+        line.starts_with(&format!("controller model {:?} ", horn.controller.kind))
+            && line.contains("not in the measured table"),
+        "{line}"
+    );
 }

@@ -98,11 +98,20 @@ pub struct ClosedLoop<'a> {
 }
 
 impl<'a> ClosedLoop<'a> {
-    /// The run of `scene` with the controller settings made from it
-    /// ([`controller_settings`]) and commissioned cells ([`COMMISSIONED`]), at t = 0 with the
-    /// first target set and started.
+    /// The run of `scene` with the model variant the scene selects ([`Station::new`]), the
+    /// controller settings made from it ([`controller_settings`]) and commissioned cells
+    /// ([`COMMISSIONED`]), at t = 0 with the first target set and started.
     pub fn new(scene: &Scene<'a>) -> Result<Self, SimError> {
         Self::with_settings(scene, &controller_settings(scene), COMMISSIONED)
+    }
+
+    /// [`ClosedLoop::new`] with the controller running `model` instead of the variant the
+    /// scene selects ([`Station::with_model`]): the QEMU benchmark times the control step of one
+    /// fidelity level this way.
+    pub fn with_model(scene: &Scene<'a>, model: AnyModel) -> Result<Self, SimError> {
+        let settings = controller_settings(scene);
+        let station = Station::with_model(scene, &settings, model)?;
+        Self::scripted(scene, station, COMMISSIONED)
     }
 
     /// The run of `scene` with the controller `settings` and the cells' `calibration` given.
@@ -111,7 +120,16 @@ impl<'a> ClosedLoop<'a> {
         settings: &Settings,
         calibration: CellCalibration,
     ) -> Result<Self, SimError> {
-        let mut run = Self::build(scene, settings, calibration, Mode::Scripted)?;
+        Self::scripted(scene, Station::new(scene, settings)?, calibration)
+    }
+
+    /// The scripted run of `scene` on `station`: first target set, started.
+    fn scripted(
+        scene: &Scene<'a>,
+        station: Station,
+        calibration: CellCalibration,
+    ) -> Result<Self, SimError> {
+        let mut run = Self::build(scene, station, calibration, Mode::Scripted)?;
         if scene.target.iter().any(|point| !point.target.is_valid()) {
             return Err(SimError::InvalidTarget);
         }
@@ -127,22 +145,17 @@ impl<'a> ClosedLoop<'a> {
     /// The scene's plant under an operator's commands ([`Mode::Operated`]): commissioned
     /// cells, the scene's controller settings, idle, no target.
     pub fn operated(scene: &Scene<'a>) -> Result<Self, SimError> {
-        Self::build(
-            scene,
-            &controller_settings(scene),
-            COMMISSIONED,
-            Mode::Operated,
-        )
+        let station = Station::new(scene, &controller_settings(scene))?;
+        Self::build(scene, station, COMMISSIONED, Mode::Operated)
     }
 
     fn build(
         scene: &Scene<'a>,
-        settings: &Settings,
+        mut station: Station,
         calibration: CellCalibration,
         mode: Mode,
     ) -> Result<Self, SimError> {
         let plant = Plant::from_scene(scene).map_err(SimError::Plant)?;
-        let mut station = Station::new(scene, settings)?;
         let seed = scene.noise_seed;
         let (normal, tangential) = station.channels_mut();
         commission(normal, &scene.normal_cell, calibration, seed, 0)?;

@@ -3,7 +3,8 @@
 //!
 //! [`ClosedLoop`] builds everything from a [`crate::scene::Scene`]: the plant
 //! ([`crate::plant::Plant::from_scene`], the scene's plant model), the controller's model
-//! ([`crate::plant::AnyModel`] from the scene's controller spec), the controller
+//! (the variant [`crate::variant::select`] chooses for the scene, built from its controller
+//! spec by [`crate::station::Station::new`]), the controller
 //! ([`controller_settings`]), the two load-cell channels with their fault checks
 //! ([`sensor_channel`]) and a bench calibration ([`commission`]: `tare` and `cal` on the
 //! simulated cells, or the datasheet calibration alone), and a [`Judge`] that keeps per-segment metrics

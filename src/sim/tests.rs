@@ -156,3 +156,109 @@ fn scenes_the_runner_cannot_hold_are_refused() {
         Some(SimError::InvalidTarget)
     );
 }
+
+/// The model each built-in scene's controller runs is the variant `select` names for it, built
+/// by the variant's own builder, whichever way the run is made (scripted, operated, or the
+/// station alone as the G474 board builds it); and the choice differs from the scene file's
+/// own model somewhere, so this cannot pass by building the own model everywhere.
+#[test]
+fn every_scene_runs_the_variant_select_names() {
+    use crate::plant::AnyModel;
+    use crate::station::Station;
+    use crate::variant::{fixed::fixed_model, select};
+
+    let mut differs = 0;
+    for built in crate::scene::SCENES {
+        let selection = select(built);
+        let variant = selection.variant.expect(built.name);
+        let chosen = fixed_model(built, variant).expect(built.name);
+        let scripted = ClosedLoop::new(built).expect(built.name);
+        let operated = ClosedLoop::operated(built).expect(built.name);
+        let station = Station::for_scene(built).expect(built.name);
+        for station in [scripted.station(), operated.station(), &station] {
+            assert_eq!(station.selection(), Some(&selection), "{}", built.name);
+            assert_eq!(station.model(), &chosen, "{}: {}", built.name, variant.name);
+        }
+        let own = AnyModel::new(built, &built.controller).expect(built.name);
+        differs += usize::from(own != chosen);
+    }
+    assert!(differs > 0, "no scene's choice differs from its own model");
+}
+
+/// A built-in scene whose selected variant is not the model its file names, so that a run of
+/// it tells the two apart.
+fn scene_choosing_another_model() -> Scene<'static> {
+    use crate::plant::AnyModel;
+    let differs = |s: &&Scene<'static>| {
+        let chosen = crate::variant::select(s).build(s);
+        chosen.is_ok() && chosen != AnyModel::new(s, &s.controller)
+    };
+    *crate::scene::SCENES
+        .iter()
+        .find(differs)
+        .expect("a scene whose choice is not its own model")
+}
+
+/// A scene the committed table did not measure (another name, or a built-in name with other
+/// contents) runs its own controller model, and says so; a budget change alone is still
+/// measured.
+#[test]
+fn a_scene_outside_the_table_keeps_its_own_model() {
+    use crate::plant::AnyModel;
+    use crate::scene::Contents;
+    use crate::variant::{Reason, select};
+
+    let horn = scene_choosing_another_model();
+    let renamed = Scene {
+        name: "my-horn",
+        ..horn
+    };
+    let moved = Scene {
+        contents: Contents {
+            load_max_n: horn.contents.load_max_n + 40.0,
+            ..horn.contents
+        },
+        ..horn
+    };
+    for unmeasured in [renamed, moved] {
+        let run = ClosedLoop::new(&unmeasured).expect("runs");
+        let own = AnyModel::new(&unmeasured, &unmeasured.controller).expect("own model");
+        let selection = run.station().selection().expect("selected");
+        assert_eq!(selection.variant, None);
+        assert_eq!(
+            selection.reason,
+            Reason::NotMeasured {
+                kind: horn.controller.kind
+            }
+        );
+        assert_eq!(run.station().model(), &own);
+    }
+    // The built-in scene itself runs another model than its own.
+    let measured = ClosedLoop::new(&horn).expect("runs");
+    let own = AnyModel::new(&horn, &horn.controller).expect("own model");
+    assert_ne!(measured.station().model(), &own);
+    let budget = Scene {
+        accuracy: crate::scene::Accuracy {
+            model_pct: 2.0 * horn.accuracy.model_pct,
+            ..horn.accuracy
+        },
+        ..horn
+    };
+    assert!(select(&budget).variant.is_some());
+}
+
+/// A run given its model runs that model, and has no selection to print.
+#[test]
+fn a_run_given_its_model_runs_it() {
+    use crate::plant::AnyModel;
+
+    let horn = scene_choosing_another_model();
+    let own = AnyModel::new(&horn, &horn.controller).expect("own model");
+    let run = ClosedLoop::with_model(&horn, own.clone()).expect("runs");
+    assert_eq!(run.station().selection(), None);
+    assert_eq!(run.station().model(), &own);
+    assert_ne!(
+        ClosedLoop::new(&horn).expect("runs").station().model(),
+        &own
+    );
+}

@@ -22,8 +22,13 @@
 //! Only fixed-point variants are candidates: the controller's model interface
 //! ([`crate::model::FrictionModel`]) is fixed point and the project keeps floats out of the
 //! control step; the float forms are measured to publish the trade. A scene that is not in the
-//! table (a file loaded at run time) or whose controller model is not catalogued keeps its own
+//! table (a file loaded at run time, also one that takes a built-in scene's name but differs
+//! from it in what was measured) or whose controller model is not catalogued keeps its own
 //! model at the default knob, and the reason says that too.
+//!
+//! [`crate::station::Station::new`] builds every scene's controller model from [`select`]
+//! ([`Selection::build`]), on the host and in the firmware alike, and the boards and
+//! `sonolube scene` print the [`Selection`] (its `Display` and `defmt` forms) at scene start.
 
 use core::fmt;
 
@@ -31,7 +36,7 @@ use super::fixed::{buildable, fixed_model};
 use super::{CATALOGUE, Family, Fidelity, Form, Variant, table};
 use crate::model::ModelError;
 use crate::plant::AnyModel;
-use crate::scene::{ModelKind, Scene};
+use crate::scene::{ModelKind, ModelSpec, Scene};
 
 /// Measured cost of one variant: instructions per evaluation on the Cortex-M4 instruction set
 /// (QEMU, `-icount shift=0`, averaged over the variant's grid points).
@@ -164,9 +169,48 @@ pub struct Selection {
     pub parts: Option<Parts>,
 }
 
-/// The variant for `scene` from the committed measurements ([`table::MEASURED`]).
+/// The variant for `scene` from the committed measurements ([`table::MEASURED`]), which were
+/// taken on the built-in scenes: a scene that differs from the built-in scene of its name in
+/// anything the measurement depends on ([`measured_as_built_in`]) is not measured and keeps
+/// its own model ([`Reason::NotMeasured`]).
 pub fn select(scene: &Scene<'_>) -> Selection {
+    if !measured_as_built_in(scene) {
+        return not_measured(scene);
+    }
     select_from(scene, &table::MEASURED)
+}
+
+/// Whether `scene` is, in everything the committed errors depend on, the built-in scene of its
+/// name: its contents (the grid), its controller's parameters (the kind aside: the kind only
+/// names the required level, whose errors the table holds), the drive frequency, the
+/// full-scale amplitude and the horn. A scene file loaded at run time under a built-in name,
+/// with other contents or parameters, was not measured. The budget (`accuracy`) is not a
+/// measurement input: it is what the selection compares the errors with.
+pub fn measured_as_built_in(scene: &Scene<'_>) -> bool {
+    let Some(built) = crate::scene::find(scene.name) else {
+        return false;
+    };
+    let controller = ModelSpec {
+        kind: built.controller.kind,
+        ..scene.controller
+    };
+    controller == built.controller
+        && scene.contents == built.contents
+        && scene.horn == built.horn
+        && scene.transducer.drive_hz == built.transducer.drive_hz
+        && scene.actuator.full_scale_amplitude_m == built.actuator.full_scale_amplitude_m
+}
+
+/// The scene's own controller model, unmeasured.
+fn not_measured(scene: &Scene<'_>) -> Selection {
+    Selection {
+        variant: None,
+        required: None,
+        reason: Reason::NotMeasured {
+            kind: scene.controller.kind,
+        },
+        parts: None,
+    }
 }
 
 /// The family and required level of `scene` (module docs, steps 1-2); `None` when the scene's
@@ -197,14 +241,7 @@ struct Candidate {
 
 /// [`select`] from the measurements `measured` (tests give their own).
 pub fn select_from(scene: &Scene<'_>, measured: &Measurements) -> Selection {
-    let not_measured = Selection {
-        variant: None,
-        required: None,
-        reason: Reason::NotMeasured {
-            kind: scene.controller.kind,
-        },
-        parts: None,
-    };
+    let not_measured = not_measured(scene);
     let Some((family, required)) = required_fidelity(scene) else {
         return not_measured;
     };
@@ -316,6 +353,23 @@ impl Selection {
 /// `Some(x)` as `x`, `None` as "not measured", for the reason line.
 struct Pct(Option<f32>);
 
+/// Instructions per evaluation to the nearest whole one, as the `Display` form prints them
+/// (`as` saturates: a negative or NaN count, which the table never holds, prints 0).
+#[cfg(feature = "defmt")]
+fn whole(instructions: f32) -> u32 {
+    (instructions + 0.5) as u32
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Pct {
+    fn format(&self, f: defmt::Formatter) {
+        match self.0 {
+            Some(x) => defmt::write!(f, "{=f32} %", x),
+            None => defmt::write!(f, "not measured"),
+        }
+    }
+}
+
 impl fmt::Display for Pct {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.0 {
@@ -412,10 +466,10 @@ impl defmt::Format for Selection {
                 candidates,
             } => defmt::write!(
                 f,
-                "model {=str}: the cheapest within budget of {=u8} measured, {=f32} instructions, max error {=f32} % <= {=f32} % of natural friction over {=u16} points",
+                "model {=str}: the cheapest within budget of {=u8} measured, {=u32} instructions, max error {=f32} % <= {=f32} % of natural friction over {=u16} points",
                 name,
                 candidates,
-                instructions,
+                whole(instructions),
                 error_pct,
                 budget_pct,
                 points
@@ -427,17 +481,17 @@ impl defmt::Format for Selection {
                 points,
             } => defmt::write!(
                 f,
-                "model {=str}: NO variant meets the budget {=f32} %; most accurate, {=f32} instructions, max error {=f32} % over {=u16} points",
+                "model {=str}: NO variant meets the budget {=f32} %; most accurate, {=u32} instructions, max error {=f32} % over {=u16} points",
                 name,
                 budget_pct,
-                instructions,
+                whole(instructions),
                 error_pct,
                 points
             ),
             Reason::NotMeasured { kind } => {
                 defmt::write!(
                     f,
-                    "model {}: the scene's own, default knob: not in the measured table",
+                    "model {} (the scene's own, default knob): not in the measured table",
                     kind
                 );
                 return;
@@ -452,21 +506,26 @@ impl defmt::Format for Selection {
                 compliance: Some(r),
             }) => defmt::write!(
                 f,
-                "; no normal vibration: contact not re-evaluated; Dahl compliance {=str} (Coulomb ratio: {} %)",
+                "; no normal vibration: contact not re-evaluated; Dahl compliance {=str} (Coulomb ratio: {})",
                 if r.skipped { "skipped" } else { "kept" },
-                r.error_pct
+                Pct(r.error_pct)
             ),
             Some(Parts::Cube {
                 plastic,
                 load_range_n: (lo, hi),
-            }) => defmt::write!(
-                f,
-                "; normal vibration: contact re-evaluated; plastic terms {=str} (elastic contact over {=f32} to {=f32} N: {} %)",
-                if plastic.skipped { "skipped" } else { "kept" },
-                lo,
-                hi,
-                plastic.error_pct
-            ),
+            }) => {
+                defmt::write!(
+                    f,
+                    "; normal vibration: contact re-evaluated; plastic terms {=str} (elastic contact ",
+                    if plastic.skipped { "skipped" } else { "kept" },
+                );
+                if hi > lo {
+                    defmt::write!(f, "over {=f32} to {=f32} N", lo, hi);
+                } else {
+                    defmt::write!(f, "at {=f32} N", lo);
+                }
+                defmt::write!(f, ": {})", Pct(plastic.error_pct));
+            }
             None => {}
         }
     }

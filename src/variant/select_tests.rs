@@ -247,3 +247,86 @@ fn the_committed_table_gives_every_builtin_scene_a_buildable_measured_choice() {
         assert_eq!(variant.fidelity.family(), family, "{}", scene.name);
     }
 }
+
+#[test]
+fn the_committed_table_applies_only_to_the_scenes_it_measured() {
+    use crate::scene::{Accuracy, Contents, Transducer};
+    let horn = find("horn-al-ss").unwrap();
+    assert!(measured_as_built_in(horn));
+    // Anything the errors were measured with, changed: not measured, the scene's own model.
+    let other = [
+        Scene {
+            name: "horn-copy",
+            ..*horn
+        },
+        Scene {
+            contents: Contents {
+                load_min_n: horn.contents.load_min_n + 20.0,
+                ..horn.contents
+            },
+            ..*horn
+        },
+        Scene {
+            controller: ModelSpec {
+                mu: horn.controller.mu + 0.05,
+                ..horn.controller
+            },
+            ..*horn
+        },
+        Scene {
+            transducer: Transducer {
+                drive_hz: horn.transducer.drive_hz + 1_000.0,
+                ..horn.transducer
+            },
+            ..*horn
+        },
+        Scene {
+            horn: None,
+            ..*horn
+        },
+    ];
+    for scene in &other {
+        assert!(!measured_as_built_in(scene), "{scene:?}");
+        let s = select(scene);
+        assert_eq!(s.variant, None);
+        assert_eq!(
+            s.reason,
+            Reason::NotMeasured {
+                kind: horn.controller.kind
+            }
+        );
+    }
+    // What the errors do not depend on (the budget, the noise, the kind the file names) keeps
+    // the measurements; a bigger budget never picks a dearer variant.
+    let base = select(horn);
+    let cost = |s: &Selection| match s.reason {
+        Reason::Meets { instructions, .. } | Reason::NoneMeets { instructions, .. } => instructions,
+        Reason::NotMeasured { .. } => f32::INFINITY,
+    };
+    let same = [
+        Scene {
+            accuracy: Accuracy {
+                model_pct: 2.0 * horn.accuracy.model_pct,
+                ..horn.accuracy
+            },
+            ..*horn
+        },
+        Scene {
+            noise_seed: horn.noise_seed + 1,
+            ..*horn
+        },
+        Scene {
+            controller: ModelSpec {
+                kind: ModelKind::CubeElasticPlastic,
+                ..horn.controller
+            },
+            ..*horn
+        },
+    ];
+    for scene in &same {
+        assert!(measured_as_built_in(scene), "{scene:?}");
+        let s = select(scene);
+        assert!(s.variant.is_some(), "{s}");
+        assert!(cost(&s) <= cost(&base), "{s} vs {base}");
+    }
+}

@@ -17,7 +17,7 @@ pub static MEASURED: Measurements = Measurements {
 static COSTS: &[Cost] = &[
     Cost {
         variant: "Littmann closed form",
-        instructions: 45.131,
+        instructions: 45.093,
     },
     Cost {
         variant: "Littmann closed form f32 micromath",
@@ -25,11 +25,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Littmann closed form f32 libm",
-        instructions: 417.845,
+        instructions: 417.769,
     },
     Cost {
         variant: "Littmann closed form f64",
-        instructions: 3355.978,
+        instructions: 3356.017,
     },
     Cost {
         variant: "Dahl update",
@@ -37,83 +37,83 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl update f32 micromath",
-        instructions: 107.145,
+        instructions: 107.213,
     },
     Cost {
         variant: "Dahl update f32 libm",
-        instructions: 60.136,
+        instructions: 60.239,
     },
     Cost {
         variant: "Dahl update f64",
-        instructions: 2228.205,
+        instructions: 2228.17,
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 287.283,
+        instructions: 287.098,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 69.074,
+        instructions: 69.012,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 242.777,
+        instructions: 242.839,
     },
     Cost {
         variant: "Coulomb ratio f64",
-        instructions: 2667.654,
+        instructions: 2667.777,
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11284.583,
+        instructions: 11284.513,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 6010.138,
+        instructions: 6010.347,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 32638.332,
+        instructions: 32638.193,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 150917.56,
+        instructions: 150917.7,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20111.666,
+        instructions: 20111.041,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
-        instructions: 11570.069,
+        instructions: 11569.652,
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 60074.375,
+        instructions: 60074.445,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 276594.3,
+        instructions: 276594.88,
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 37608.055,
+        instructions: 37608.75,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22717.639,
+        instructions: 22717.916,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 114685.484,
+        instructions: 114688.125,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 523938.06,
+        instructions: 523934.94,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 530.151,
+        instructions: 530.0,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
@@ -121,19 +121,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 260.454,
+        instructions: 260.303,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9421.818,
+        instructions: 9421.666,
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 764.09,
+        instructions: 763.484,
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 631.666,
+        instructions: 631.818,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
@@ -141,7 +141,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15224.545,
+        instructions: 15224.848,
     },
     Cost {
         variant: "cube el N=16",
@@ -149,39 +149,39 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
-        instructions: 1141.969,
+        instructions: 1141.818,
     },
     Cost {
         variant: "cube el N=16 f32 libm",
-        instructions: 647.121,
+        instructions: 646.969,
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26871.363,
+        instructions: 26871.818,
     },
     Cost {
         variant: "cube el N=32",
-        instructions: 2167.727,
+        instructions: 2167.878,
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.666,
+        instructions: 2161.818,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
-        instructions: 1163.333,
+        instructions: 1163.181,
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50107.574,
+        instructions: 50107.273,
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 530.0,
+        instructions: 529.696,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 377.878,
+        instructions: 378.03,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
@@ -189,11 +189,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9412.727,
+        instructions: 9412.575,
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 763.787,
+        instructions: 763.939,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
@@ -201,15 +201,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
-        instructions: 388.333,
+        instructions: 388.484,
     },
     Cost {
         variant: "cube ep N=8 f64",
-        instructions: 15212.424,
+        instructions: 15211.969,
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1231.818,
+        instructions: 1231.969,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
@@ -217,15 +217,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 647.272,
+        instructions: 646.969,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26860.303,
+        instructions: 26859.695,
     },
     Cost {
         variant: "cube ep N=32",
-        instructions: 2167.727,
+        instructions: 2167.878,
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
@@ -233,11 +233,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
-        instructions: 1162.727,
+        instructions: 1162.878,
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50094.695,
+        instructions: 50094.395,
     },
 ];
 

@@ -187,6 +187,7 @@ async fn control_task() {
         scene.transducer.drive_hz,
         BoardRig::CYCLE_HZ
     );
+    rig.log_model();
     let stats = control::run(&mut rig, |_| Injection::None).await;
     // The board's loop has no end of job; should it end, the drive goes safe.
     safe::drive_safe();

@@ -62,8 +62,9 @@ struct Setup {
 }
 
 impl Setup {
-    /// Configuration (`f64`, the model's tables), between two steps; its duration on silicon
-    /// is unmeasured (an overrun is counted if it exceeds a period).
+    /// Configuration (the model variant's selection from the measured table, `f64`, the
+    /// model's tables), between two steps; its duration on silicon is unmeasured (an overrun is
+    /// counted if it exceeds a period).
     fn new(scene: &'static Scene<'static>) -> Result<Self, SceneRefusal> {
         let real = config::LOAD_CELL_INTERNAL
             .calibration()
@@ -140,6 +141,20 @@ impl BoardRig {
         self.setup.scene
     }
 
+    /// Logs the model variant the controller runs and why ([`sonolube::variant::select`]), at
+    /// scene start.
+    pub fn log_model(&self) {
+        let (scene, station) = (self.setup.scene, &self.setup.station);
+        match station.selection() {
+            Some(selection) => defmt::info!("scene {=str}: controller {}", scene.name, selection),
+            None => defmt::info!(
+                "scene {=str}: controller model {} (given, not selected)",
+                scene.name,
+                station.model().kind()
+            ),
+        }
+    }
+
     /// `scene NAME`: the new scene's station replaces the old one (calibration, target and
     /// latched fault included), with the drive off.
     fn select_scene(&mut self, command: &Command) -> Result<(), ProtocolError> {
@@ -171,6 +186,7 @@ impl BoardRig {
                     scene.transducer.drive_hz,
                     self.setup.sliding_velocity_m_per_s
                 );
+                self.log_model();
                 Ok(())
             }
             Err(refusal) => {

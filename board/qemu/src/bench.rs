@@ -22,7 +22,9 @@
 //!
 //! The control step is `sonolube::sim::ClosedLoop::control_phase` (target, sensing, estimate,
 //! model and its inverse, controller, drive command), timed around every step of a scene whose
-//! controller model is set to the fidelity level; the plant's phase is not timed.
+//! controller model is set to the fidelity level at its default knob
+//! (`ClosedLoop::with_model`, not the variant the scene selects); the plant's phase is not
+//! timed.
 //!
 //! Output, one line per measurement (parsed by `sonolube speed`):
 //! `bench NAME: N.NNN instructions per call (C calls)`.
@@ -32,8 +34,9 @@ use core::mem::MaybeUninit;
 
 use sonolube::fx::Q1_31;
 use sonolube::model::{FrictionModel, OperatingPoint, dahl, littmann};
+use sonolube::plant::AnyModel;
 use sonolube::scene::{ModelKind, ModelSpec, SCENES, Scene};
-use sonolube::sim::ClosedLoop;
+use sonolube::sim::{ClosedLoop, SimError};
 use sonolube::variant::float_inplane::{dahl_update, littmann as float_littmann};
 use sonolube::variant::grid::{
     DAHL_UPDATE_POINTS, DahlUpdateInput, LITTMANN_POINTS, SceneGrid, dahl_update_input,
@@ -294,7 +297,12 @@ fn control_step(name: &str, scene_name: &str, fidelity: Fidelity, shift: u32) ->
         },
         ..*scene
     };
-    let mut closed_loop = match ClosedLoop::new(&scene) {
+    // The level's own model at its default knob, not the variant the scene selects: the row
+    // times the level.
+    let run = AnyModel::new(&scene, &scene.controller)
+        .map_err(SimError::Model)
+        .and_then(|model| ClosedLoop::with_model(&scene, model));
+    let mut closed_loop = match run {
         Ok(run) => run,
         Err(error) => {
             defmt::error!("bench {=str}: {}", name, error);

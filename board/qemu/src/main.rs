@@ -168,6 +168,7 @@ async fn control_task(mut rig: SimulatedRig, args: Args) {
             scene.control_rate_hz
         );
     }
+    rig.log_model();
     let steps = scene.step_count();
     let start = (
         time_driver::cycles(),

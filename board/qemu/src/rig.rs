@@ -40,6 +40,22 @@ impl SimulatedRig {
         self.scene
     }
 
+    /// Logs the model variant the controller runs and why ([`sonolube::variant::select`]), at
+    /// scene start.
+    pub fn log_model(&self) {
+        let station = self.run.station();
+        match station.selection() {
+            Some(selection) => {
+                defmt::info!("scene {=str}: controller {}", self.scene.name, selection)
+            }
+            None => defmt::info!(
+                "scene {=str}: controller model {} (given, not selected)",
+                self.scene.name,
+                station.model().kind()
+            ),
+        }
+    }
+
     /// The judge's summary of the steps so far.
     pub fn summary(&self) -> RunSummary {
         time_driver::exclude(|| self.run.summary())
@@ -65,6 +81,7 @@ impl SimulatedRig {
             Ok(run) => {
                 self.scene = scene;
                 self.run = run;
+                self.log_model();
                 Ok(())
             }
             Err(error) => {

@@ -1,6 +1,8 @@
 //! `sonolube scene`: runs a scene closed loop on the host ([`sonolube::sim::ClosedLoop`]),
-//! writes its time series as CSV and an SVG plot, and prints the metrics and the verdict of
-//! each of the scene's criteria.
+//! writes its time series as CSV and an SVG plot, and prints the model variant the controller
+//! runs and why (chosen by [`sonolube::variant::select`], as the firmware logs it at scene
+//! start), the metrics and the verdict of each of the scene's criteria. `--all` prints one line
+//! per scene: its verdicts, then the model it ran.
 //!
 //! ```text
 //! sonolube scene NAME [--out DIR] [--file PATH.toml]
@@ -50,6 +52,7 @@ use sonolube::scene::{SCENES, Scene};
 use sonolube::sim::{ClosedLoop, RunSummary};
 
 pub use csv::csv;
+pub use report::{model_line, model_name};
 
 const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml]\n       \
                      sonolube scene --all [--out DIR]\n";
@@ -109,9 +112,9 @@ pub fn run(args: &[String]) -> ExitCode {
         (None, None) => return usage("a scene NAME, --file or --all is needed"),
     };
     match run_one(&scene, &out) {
-        Ok((summary, report)) => {
-            print!("{report}");
-            exit(summary.passed())
+        Ok(run) => {
+            print!("{}", run.report);
+            exit(run.summary.passed())
         }
         Err(error) => {
             eprintln!("sonolube scene {}: {error}", scene.name);
@@ -141,7 +144,7 @@ fn run_all(out: &Path) -> ExitCode {
     let (mut passed, mut failed) = (0, 0);
     for scene in SCENES {
         let line = match run_one(scene, out) {
-            Ok((summary, _)) => {
+            Ok(SceneRun { summary, model, .. }) => {
                 let verdicts: Vec<String> = summary
                     .verdicts
                     .iter()
@@ -153,7 +156,12 @@ fn run_all(out: &Path) -> ExitCode {
                 } else {
                     failed += 1
                 }
-                format!("{} {:<13} {}", pass(ok), scene.name, verdicts.join(", "))
+                format!(
+                    "{} {:<13} {}; {model}",
+                    pass(ok),
+                    scene.name,
+                    verdicts.join(", ")
+                )
             }
             Err(error) => {
                 failed += 1;
@@ -166,26 +174,43 @@ fn run_all(out: &Path) -> ExitCode {
     exit(failed == 0)
 }
 
-/// Runs `scene`, writes its CSV and SVG to `out`, returns the summary and the report text.
-pub fn run_one(scene: &Scene<'_>, out: &Path) -> Result<(RunSummary, String), String> {
+/// What [`run_one`] returns.
+#[derive(Debug, Clone)]
+pub struct SceneRun {
+    /// The judge's summary.
+    pub summary: RunSummary,
+    /// The text `sonolube scene NAME` prints.
+    pub report: String,
+    /// The model the controller ran, in a few words ([`model_name`]).
+    pub model: String,
+}
+
+/// Runs `scene`, writes its CSV and SVG to `out`, returns the summary, the report text and
+/// the model the controller ran.
+pub fn run_one(scene: &Scene<'_>, out: &Path) -> Result<SceneRun, String> {
     let mut sim = ClosedLoop::new(scene).map_err(|e| format!("cannot build the run: {e:?}"))?;
     let mut records = Vec::with_capacity(scene.step_count() as usize);
     while let Some(record) = sim.step() {
         records.push(record);
     }
     let summary = sim.summary();
+    let station = sim.station();
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let csv_path = out.join(format!("{}.csv", scene.name));
     let svg_path = out.join(format!("{}.svg", scene.name));
     std::fs::write(&csv_path, csv(&records)).map_err(|e| format!("{}: {e}", csv_path.display()))?;
     std::fs::write(&svg_path, svg(scene, &summary, &records))
         .map_err(|e| format!("{}: {e}", svg_path.display()))?;
-    let mut text = report(scene, &summary, &records);
+    let mut text = report(scene, station, &summary, &records);
     let _ = writeln!(
         text,
         "  wrote {} and {}",
         csv_path.display(),
         svg_path.display()
     );
-    Ok((summary, text))
+    Ok(SceneRun {
+        summary,
+        report: text,
+        model: model_name(station),
+    })
 }

@@ -303,8 +303,8 @@ impl Report<'_> {
              against one reference level, or a kernel's grid) the variant competes in, or \
              dominated in every one. The control-step rows time the whole step (target, \
              sensing, estimate, model and its inverse, controller, drive command) with the \
-             level's model at the knob the scenes build it with; their error is that of the \
-             model they run.\n"
+             level's model at its default knob (the scene's own model, not the variant the \
+             scene selects); their error is that of the model they run.\n"
         );
         let _ = writeln!(s, "## Goals (issue 7)\n");
         self.goals(&mut s);
@@ -376,7 +376,8 @@ the call itself with its return and the `black_box` traffic on its arguments and
 instructions). The SysTick rounding (+-40 per interval) is spread over each chunk: well under
 one instruction per call. Runs are deterministic: the same build prints the same counts. The
 control-step rows time `ClosedLoop::control_phase` at every step of the named scene with its
-controller model set to the level; the plant is not timed.
+controller model set to the level at its default knob (`ClosedLoop::with_model`); the plant is
+not timed.
 
 **Host time** is measured by the `sonolube speed` harness in a release build: each variant on
 the same inputs (prepared in its own number type, passed through `black_box`), passes repeated

@@ -7,6 +7,8 @@ use sonolube::scene::{Channel, Criterion, FaultKind, Scene};
 use sonolube::sim::{
     DEFAULT_BAND, DEFAULT_STEADY_AFTER_S, Measured, Origin, RunSummary, StepRecord,
 };
+use sonolube::station::Station;
+use sonolube::variant::Selection;
 
 /// Where the segments' steady part starts, s after a change: the first `Settle` criterion's
 /// time, else the judge's default (as `sonolube::sim::Judge` does).
@@ -48,19 +50,51 @@ pub(super) fn fault_text(kind: FaultKind) -> String {
     }
 }
 
-pub(super) fn report(scene: &Scene<'_>, summary: &RunSummary, records: &[StepRecord]) -> String {
+/// The line naming the model the controller runs and why: the station's selection
+/// ([`sonolube::variant::select`], as the firmware logs it at scene start), or the model it
+/// was given.
+pub fn model_line(station: &Station) -> String {
+    match station.selection() {
+        Some(selection) => format!("controller {selection}"),
+        None => format!(
+            "controller model {:?} (given, not selected)",
+            station.model().kind()
+        ),
+    }
+}
+
+/// The model the controller runs, in a few words, for the `--all` lines: the selected
+/// variant's name, or the scene's own model kind when nothing was measured or selected.
+pub fn model_name(station: &Station) -> String {
+    match station.selection() {
+        Some(Selection {
+            variant: Some(variant),
+            ..
+        }) => format!("model {}", variant.name),
+        Some(_) => format!("own model {:?} (not measured)", station.model().kind()),
+        None => format!("model {:?} (given)", station.model().kind()),
+    }
+}
+
+pub(super) fn report(
+    scene: &Scene<'_>,
+    station: &Station,
+    summary: &RunSummary,
+    records: &[StepRecord],
+) -> String {
     let mut text = String::new();
     let w = &mut text;
     let _ = writeln!(w, "scene {}: {}", scene.name, scene.description);
     let _ = writeln!(
         w,
-        "  {} steps at {} Hz ({} s); controller model {:?}, plant model {:?}",
+        "  {} steps at {} Hz ({} s); scene's controller model {:?}, plant model {:?}",
         summary.steps,
         num(scene.control_rate_hz),
         num(scene.duration_s),
         scene.controller.kind,
         scene.plant.kind
     );
+    let _ = writeln!(w, "  {}", model_line(station));
     let band = num(band_fraction(scene) * 100.0);
     let _ = writeln!(
         w,
