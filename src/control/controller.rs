@@ -33,6 +33,9 @@ pub struct ControllerState {
     gains: PiGains,
     prediction: LowPass<30>,
     prediction_valid: bool,
+    /// The last model inversion's amplitude (Q1.31 fraction of full scale, [0, 1)): where
+    /// the next inversion starts ([`FrictionModel::invert_from`]); zero from each ramp-up.
+    feedforward: Q1_31,
     target: Option<(Target, PreparedTarget)>,
 }
 
@@ -77,6 +80,7 @@ impl Controller {
                 gains: config.gains.slow(),
                 prediction: LowPass::new(Q2_30::ONE),
                 prediction_valid: false,
+                feedforward: Q1_31::ZERO,
                 target: None,
             },
             config,
@@ -173,6 +177,7 @@ impl Controller {
         if now == SupervisorState::RampUp && before != SupervisorState::RampUp {
             self.state.pi.reset();
             self.state.prediction_valid = false;
+            self.state.feedforward = Q1_31::ZERO;
             self.state.boost.restart();
         }
     }
@@ -241,7 +246,8 @@ impl Controller {
                 .value
                 .saturating_add(candidate.correction())
                 .value;
-            let inversion = model.invert(&point, command.max(Q2_30::ZERO))?;
+            let inversion = model.invert_from(&point, command.max(Q2_30::ZERO), s.feedforward)?;
+            s.feedforward = inversion.amplitude;
             let actuator = inversion.amplitude > max;
             let desired = inversion.amplitude.min(max);
             let clamp = match inversion.reach {

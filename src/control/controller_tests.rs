@@ -357,3 +357,58 @@ fn force_target_uses_the_measured_load() {
     assert!((plant.ratio() - 0.6).abs() < 0.006, "{}", plant.ratio());
     assert_eq!(out.reach, Some(Reach::Reached));
 }
+
+/// Records the hint of every inversion and the amplitude it returned.
+struct HintRecorder {
+    inner: LittmannModel,
+    calls: core::cell::RefCell<Vec<(Q1_31, Q1_31)>>,
+}
+
+impl FrictionModel for HintRecorder {
+    fn ratio(&self, point: &OperatingPoint, amplitude: Q1_31) -> Result<Q2_30, ModelError> {
+        self.inner.ratio(point, amplitude)
+    }
+
+    fn invert_from(
+        &self,
+        point: &OperatingPoint,
+        target: Q2_30,
+        start: Q1_31,
+    ) -> Result<crate::model::Inversion, ModelError> {
+        let inversion = self.inner.invert(point, target)?;
+        self.calls.borrow_mut().push((start, inversion.amplitude));
+        Ok(inversion)
+    }
+}
+
+#[test]
+fn each_inversion_starts_from_the_previous_one_and_a_restart_from_zero() {
+    let (mut ctl, inner, mut plant) = setup();
+    let model = HintRecorder {
+        inner,
+        calls: core::cell::RefCell::new(Vec::new()),
+    };
+    ctl.set_target(HALF).unwrap();
+    run(&mut ctl, &model, &mut plant, 100);
+    assert!(model.calls.borrow().is_empty(), "no inversion while idle");
+    ctl.start().unwrap();
+    run(&mut ctl, &model, &mut plant, 200);
+    let check = |calls: &[(Q1_31, Q1_31)]| {
+        assert!(calls.len() > 100, "{} inversions", calls.len());
+        assert_eq!(calls[0].0, Q1_31::ZERO, "the first starts from zero");
+        for pair in calls.windows(2) {
+            assert_eq!(
+                pair[1].0, pair[0].1,
+                "a hint that is not the previous answer"
+            );
+        }
+        assert!(calls.last().unwrap().1.to_f64() > 0.5);
+    };
+    check(&model.calls.borrow());
+    ctl.stop().unwrap();
+    run(&mut ctl, &model, &mut plant, 400);
+    model.calls.borrow_mut().clear();
+    ctl.start().unwrap();
+    run(&mut ctl, &model, &mut plant, 200);
+    check(&model.calls.borrow());
+}

@@ -8,7 +8,8 @@
 //! point left of the root, and a step from the right lands left of it. [`CubeModel::invert`]
 //! runs a bracketed Newton iteration with the exact derivative
 //! dW0/da = `-<G c (K + 3 Y / (1 + a Y c))>` (a few multiplies more per node), from a = 0 or
-//! from a previous solution ([`CubeModel::invert_from`]): about 5 evaluations cold and 3-4 warm,
+//! from a previous solution ([`FrictionModel::invert_from`], which the controller calls with the
+//! previous step's amplitude): about 5 evaluations cold and 3-4 warm,
 //! instead of the 18 of the default bisection. From a = 0 the first step needs no evaluation:
 //! W0(0) = 1 and W0'(0) = -(K + 3 Y) `<c>` exactly. It stops when |F'/F - target| <= 2^-22
 //! (2.4e-7, above the fixed-point granularity of W0(a), about 5e-8) or when the bracket closes
@@ -60,22 +61,6 @@ impl CubeModel {
     pub fn ratio_prepared(&self, point: &CubePoint, amplitude: Q1_31) -> Result<Q2_30, ModelError> {
         let a = amplitude.convert::<30>().map_err(fx_error("amplitude"))?;
         self.scene.ratio_q2_30(point, a)
-    }
-
-    /// Like [`FrictionModel::invert`], warm-started from `start` (e.g. the previous control
-    /// step's amplitude): usually 2-3 evaluations when the load and target moved little.
-    pub fn invert_from(
-        &self,
-        point: &OperatingPoint,
-        target: Q2_30,
-        start: Q1_31,
-    ) -> Result<Inversion, ModelError> {
-        if self.scene.has_u_term() || self.scene.quadrature.window() != SlipWindow::SurfacesApart {
-            return invert(self, point, target, BISECTION_STEPS);
-        }
-        let prepared = self.prepare(point)?;
-        let start = start.convert::<30>().map_err(fx_error("amplitude"))?;
-        self.newton(&prepared, target, start.to_bits() as i64)
     }
 
     /// W0 (Q.30) and -dW0/da (Q.30 per unit amplitude) at amplitude `a` (Q.30 in [0, 1]):
@@ -200,9 +185,26 @@ impl FrictionModel for CubeModel {
     /// Bracketed Newton from a = 0 (see the module docs); default bisection for scenes with
     /// an active u-term or the literal window. Measured (as for `ratio`, N = 16, 40 N, target
     /// 0.6): 8,960 instructions cold, 6,290 warm-started from the solution for 0.605
-    /// ([`CubeModel::invert_from`]), against 27,200 for the default 16-step bisection.
+    /// ([`FrictionModel::invert_from`]), against 27,200 for the default 16-step bisection.
     fn invert(&self, point: &OperatingPoint, target: Q2_30) -> Result<Inversion, ModelError> {
         self.invert_from(point, target, Q1_31::ZERO)
+    }
+
+    /// The Newton iteration warm-started from `start` (the controller passes the previous
+    /// step's amplitude): usually 2-3 evaluations when the load and the target moved little.
+    /// Scenes with an active u-term or the literal window bisect and ignore `start`.
+    fn invert_from(
+        &self,
+        point: &OperatingPoint,
+        target: Q2_30,
+        start: Q1_31,
+    ) -> Result<Inversion, ModelError> {
+        if self.scene.has_u_term() || self.scene.quadrature.window() != SlipWindow::SurfacesApart {
+            return invert(self, point, target, BISECTION_STEPS);
+        }
+        let prepared = self.prepare(point)?;
+        let start = start.convert::<30>().map_err(fx_error("amplitude"))?;
+        self.newton(&prepared, target, start.to_bits() as i64)
     }
 }
 

@@ -126,6 +126,21 @@ pub trait FrictionModel {
     fn invert(&self, point: &OperatingPoint, target: Q2_30) -> Result<Inversion, ModelError> {
         invert(self, point, target, BISECTION_STEPS)
     }
+
+    /// [`Self::invert`] with a hint: `start` (Q1.31 fraction of full scale, [0, 1)) is where
+    /// the answer probably is, e.g. the previous control step's amplitude. Iterative inverses
+    /// start there (the cube model's Newton iteration: fewer evaluations when the load and the
+    /// target moved little); the result meets the same tolerance as [`Self::invert`]'s, from
+    /// any `start`. The default ignores the hint.
+    fn invert_from(
+        &self,
+        point: &OperatingPoint,
+        target: Q2_30,
+        start: Q1_31,
+    ) -> Result<Inversion, ModelError> {
+        let _ = start;
+        self.invert(point, target)
+    }
 }
 
 /// Bisection steps of the default inversion: 2^-16 of full scale, finer than the drive's

@@ -131,6 +131,20 @@ impl FrictionModel for AnyModel {
             AnyModel::Cube(model) => model.invert(point, target),
         }
     }
+
+    fn invert_from(
+        &self,
+        point: &OperatingPoint,
+        target: Q2_30,
+        start: Q1_31,
+    ) -> Result<Inversion, ModelError> {
+        match self {
+            AnyModel::Coulomb(model) => model.invert_from(point, target, start),
+            AnyModel::ExpCoulomb(model) => model.invert_from(point, target, start),
+            AnyModel::Dahl(model) => model.invert_from(point, target, start),
+            AnyModel::Cube(model) => model.invert_from(point, target, start),
+        }
+    }
 }
 
 fn missing(input: &'static str) -> ModelError {

@@ -25,11 +25,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Littmann closed form f32 libm",
-        instructions: 417.769,
+        instructions: 417.788,
     },
     Cost {
         variant: "Littmann closed form f64",
-        instructions: 3356.017,
+        instructions: 3356.036,
     },
     Cost {
         variant: "Dahl update",
@@ -37,15 +37,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl update f32 micromath",
-        instructions: 107.213,
+        instructions: 107.282,
     },
     Cost {
         variant: "Dahl update f32 libm",
-        instructions: 60.239,
+        instructions: 60.17,
     },
     Cost {
         variant: "Dahl update f64",
-        instructions: 2228.17,
+        instructions: 2228.205,
     },
     Cost {
         variant: "Coulomb ratio",
@@ -53,11 +53,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 69.012,
+        instructions: 68.95,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 242.839,
+        instructions: 242.777,
     },
     Cost {
         variant: "Coulomb ratio f64",
@@ -65,23 +65,23 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11284.513,
+        instructions: 11284.375,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 6010.347,
+        instructions: 6010.208,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 32638.193,
+        instructions: 32638.473,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 150917.7,
+        instructions: 150917.16,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20111.041,
+        instructions: 20111.111,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
@@ -89,27 +89,27 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 60074.445,
+        instructions: 60074.027,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 276594.88,
+        instructions: 276594.03,
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 37608.75,
+        instructions: 37608.54,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22717.916,
+        instructions: 22717.777,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 114688.125,
+        instructions: 114684.445,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 523934.94,
+        instructions: 523935.75,
     },
     Cost {
         variant: "cube el N=4",
@@ -121,19 +121,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 260.303,
+        instructions: 260.151,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9421.666,
+        instructions: 9421.969,
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 763.484,
+        instructions: 763.939,
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 631.818,
+        instructions: 632.121,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
@@ -141,7 +141,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15224.848,
+        instructions: 15225.151,
     },
     Cost {
         variant: "cube el N=16",
@@ -157,7 +157,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26871.818,
+        instructions: 26871.666,
     },
     Cost {
         variant: "cube el N=32",
@@ -165,11 +165,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.818,
+        instructions: 2161.666,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
-        instructions: 1163.181,
+        instructions: 1162.878,
     },
     Cost {
         variant: "cube el N=32 f64",
@@ -177,11 +177,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 529.696,
+        instructions: 530.0,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 378.03,
+        instructions: 377.878,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
@@ -193,35 +193,35 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 763.939,
+        instructions: 763.787,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 631.818,
+        instructions: 631.666,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
-        instructions: 388.484,
+        instructions: 388.333,
     },
     Cost {
         variant: "cube ep N=8 f64",
-        instructions: 15211.969,
+        instructions: 15212.121,
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1231.969,
+        instructions: 1231.666,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
-        instructions: 1141.818,
+        instructions: 1141.666,
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 646.969,
+        instructions: 647.121,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26859.695,
+        instructions: 26859.848,
     },
     Cost {
         variant: "cube ep N=32",
@@ -229,7 +229,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
-        instructions: 2161.666,
+        instructions: 2161.363,
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
