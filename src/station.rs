@@ -170,13 +170,22 @@ impl Station {
             Command::Freq { freq_chz } => {
                 if !FREQ_RANGE_CHZ.contains(&freq_chz) {
                     // The parser never produces one; a program that builds commands may.
-                    let mut token: heapless::String<16> = heapless::String::new();
-                    let _ = write!(token, "{}.{:02}", freq_chz / 100, freq_chz % 100);
                     return Err(ProtocolError::OutOfRange {
-                        token: TokenText::new(token.as_str()),
+                        token: freq_token(freq_chz),
                         quantity: &DRIVE_FREQ,
                     });
                 }
+                // The current rating's ceiling moves with the frequency (I = 2 pi f C V): the
+                // controller takes the new ceiling with the new frequency, or neither changes.
+                let config = self
+                    .controller
+                    .config()
+                    .at_drive_frequency(f64::from(freq_chz) / 100.0)
+                    .map_err(|_| ProtocolError::OutOfRange {
+                        token: freq_token(freq_chz),
+                        quantity: &DRIVE_FREQ,
+                    })?;
+                self.controller.reconfigure(config);
                 self.drive_hz = freq_chz as f32 / 100.0;
                 self.drive_freq_chz = freq_chz;
                 Ok(())
@@ -292,6 +301,14 @@ impl Station {
     }
 }
 
+/// A drive frequency in cHz as the protocol writes it (`39500.50`), for an error reply.
+fn freq_token(freq_chz: u32) -> TokenText {
+    let mut token: heapless::String<16> = heapless::String::new();
+    // 16 bytes hold every u32 with two decimals.
+    let _ = write!(token, "{}.{:02}", freq_chz / 100, freq_chz % 100);
+    TokenText::new(token.as_str())
+}
+
 fn cal_failed(reason: &'static str) -> ProtocolError {
     ProtocolError::CalFailed { reason }
 }
@@ -397,6 +414,56 @@ mod tests {
             Some(ErrorCode::WrongState)
         );
         assert_eq!(code(run.execute(&cal)), Some(ErrorCode::WrongState));
+    }
+
+    /// The current a ceiling lets through at the configured drive frequency, A.
+    fn current_at_ceiling(run: &ClosedLoop<'_>) -> (f64, crate::control::Binding) {
+        let config = run.station().controller().config();
+        let r = config.actuator();
+        let a = config.limit().max_amplitude.to_f64();
+        let current = core::f64::consts::TAU
+            * r.drive_frequency_hz
+            * r.capacitance_f
+            * a
+            * r.full_scale_voltage_v;
+        (current, config.limit().binding)
+    }
+
+    #[test]
+    fn the_amplitude_ceiling_follows_the_drive_frequency() {
+        use crate::control::Binding;
+        // The welding converter of horn-al-ss: 1 kV at full scale into 20 nF, 6 A rating.
+        let mut run = ClosedLoop::operated(find("horn-al-ss").expect("built in")).expect("runs");
+        let rating = run.station().controller().config().actuator().max_current_a;
+        let (current, binding) = current_at_ceiling(&run);
+        assert_ne!(
+            binding,
+            Binding::Current,
+            "{current} A at the scene's 20.03 kHz"
+        );
+        assert!(current < rating);
+        // At 60 kHz, 2 pi f C V_fs = 7.5 A at full scale: the 6 A rating binds.
+        assert_eq!(
+            run.execute(&Command::Freq {
+                freq_chz: 6_000_000
+            }),
+            Ok(())
+        );
+        let (current, binding) = current_at_ceiling(&run);
+        assert_eq!(binding, Binding::Current);
+        assert!(
+            current <= rating && current > rating * (1.0 - 1e-6),
+            "{current} A"
+        );
+        // Back down: the ceiling rises again.
+        assert_eq!(
+            run.execute(&Command::Freq {
+                freq_chz: 2_003_000
+            }),
+            Ok(())
+        );
+        let (_, binding) = current_at_ceiling(&run);
+        assert_ne!(binding, Binding::Current);
     }
 
     #[test]

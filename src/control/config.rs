@@ -166,6 +166,8 @@ pub struct Config {
     pub(super) ramp: RampConfig,
     pub(super) gains: GainSchedule,
     pub(super) limit: AmplitudeLimit,
+    /// The ratings `limit` was computed from, kept for [`Config::at_drive_frequency`].
+    pub(super) actuator: ActuatorRatings,
 }
 
 /// A positive finite value, or the error naming `setting`.
@@ -272,7 +274,30 @@ impl Config {
             )
             .map_err(ConfigError::Gains)?,
             limit: AmplitudeLimit::new(&s.actuator).map_err(ConfigError::Limits)?,
+            actuator: s.actuator,
         })
+    }
+
+    /// This configuration with the drive at `drive_frequency_hz`: the amplitude ceiling is
+    /// recomputed, since the current rating binds at `a = I_max / (2 pi f C V_fs)`; everything
+    /// else is kept. Configuration only (`f64`), between two steps. Errors: the frequency is not
+    /// finite and positive, or the ratings leave no headroom there
+    /// ([`ConfigError::Limits`]).
+    pub fn at_drive_frequency(&self, drive_frequency_hz: f64) -> Result<Self, ConfigError> {
+        let actuator = ActuatorRatings {
+            drive_frequency_hz,
+            ..self.actuator
+        };
+        Ok(Self {
+            limit: AmplitudeLimit::new(&actuator).map_err(ConfigError::Limits)?,
+            actuator,
+            ..*self
+        })
+    }
+
+    /// The actuator ratings the ceiling is computed from (at the present drive frequency).
+    pub const fn actuator(&self) -> ActuatorRatings {
+        self.actuator
     }
 
     /// The control period, s.

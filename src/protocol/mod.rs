@@ -45,7 +45,7 @@
 //! | `scene <name>` | `[a-z0-9_-]`, 1 to 24 bytes, not `list` or `none` | select a scene | `ok scene=demo` |
 //! | `start` | | drive on, close the friction loop | `ok` |
 //! | `stop` | | open the loop, drive off | `ok` |
-//! | `freq <Hz>` | `20000 <= f <= 60000` hertz, 0.01 Hz | fixed drive frequency | `ok freq_hz=40000.00` |
+//! | `freq <Hz>` | `20000 <= f <= 60000` hertz, 0.01 Hz | fixed drive frequency; the actuator ceiling is recomputed for it (current rating) | `ok freq_hz=40000.00` |
 //! | `freq auto` | | search the resonance and drive there | `ok freq_hz=auto` |
 //! | `tare normal\|tangential\|all` | | zero force sensors (no load) | `ok tare=all` |
 //! | `cal normal\|tangential <N>` | `0 < N <= 50000` newtons, 0.001 N | set a sensor's gain from a known load | `ok cal=normal load_n=10.000` |
