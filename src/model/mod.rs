@@ -20,6 +20,7 @@ pub mod coulomb_sampled;
 pub mod cube;
 pub mod cube_model;
 mod cube_nodes;
+pub mod cube_table;
 pub mod dahl;
 pub(crate) mod dahl_cycle;
 pub(crate) mod dahl_quadrature;

@@ -10,6 +10,7 @@ use crate::model::contact::{ContactKind, ContactParams, EStarRule};
 use crate::model::coulomb::{CoulombConstants, CoulombModel};
 use crate::model::cube::{CubeOptions, CubeParams};
 use crate::model::cube_model::CubeModel;
+use crate::model::cube_table::CubeTable;
 use crate::model::dahl::DahlParams;
 use crate::model::dahl_steady::DahlModel;
 use crate::model::horn::UPhase;
@@ -27,7 +28,10 @@ pub const CUBE_QUADRATURE_POINTS: usize = crate::model::cube::DEFAULT_QUADRATURE
 pub const DAHL_QUADRATURE_POINTS: u32 = 64;
 
 /// One of the concrete friction models. The cube variant carries its quadrature tables (about
-/// 1 KB); there is no heap to box it into, and a plant or controller holds one model.
+/// 1 KB), the tabulated cube its exact model and a fixed-capacity table of 17 x 17 Q2.30 nodes
+/// (1,156 bytes, whatever the table size: [`crate::model::cube_table`]), which makes the enum
+/// about 2.2 KB (a test pins it); there is no heap to box it into, and a plant or
+/// controller holds one model.
 #[derive(Debug, Clone, PartialEq)]
 #[allow(clippy::large_enum_variant)]
 pub enum AnyModel {
@@ -40,6 +44,10 @@ pub enum AnyModel {
     /// Cube model, elastic or elastic-plastic contact ([`ModelKind::CubeElastic`],
     /// [`ModelKind::CubeElasticPlastic`]).
     Cube(CubeModel),
+    /// Cube model tabulated over (ln load, amplitude) and interpolated, with its exact model for
+    /// loads outside the table (a model variant only: no scene kind names it;
+    /// `crate::variant::select` chooses it).
+    CubeTable(CubeTable),
 }
 
 impl AnyModel {
@@ -105,10 +113,8 @@ impl AnyModel {
             AnyModel::Coulomb(_) => ModelKind::Coulomb,
             AnyModel::ExpCoulomb(_) => ModelKind::ExpCoulomb,
             AnyModel::Dahl(_) => ModelKind::Dahl,
-            AnyModel::Cube(model) => match model.scene().contact().scene().kind {
-                ContactKind::Elastic => ModelKind::CubeElastic,
-                ContactKind::ElasticPlastic => ModelKind::CubeElasticPlastic,
-            },
+            AnyModel::Cube(model) => cube_kind(model),
+            AnyModel::CubeTable(table) => cube_kind(table.exact()),
         }
     }
 }
@@ -120,6 +126,7 @@ impl FrictionModel for AnyModel {
             AnyModel::ExpCoulomb(model) => model.ratio(point, amplitude),
             AnyModel::Dahl(model) => model.ratio(point, amplitude),
             AnyModel::Cube(model) => model.ratio(point, amplitude),
+            AnyModel::CubeTable(model) => model.ratio(point, amplitude),
         }
     }
 
@@ -129,6 +136,7 @@ impl FrictionModel for AnyModel {
             AnyModel::ExpCoulomb(model) => model.invert(point, target),
             AnyModel::Dahl(model) => model.invert(point, target),
             AnyModel::Cube(model) => model.invert(point, target),
+            AnyModel::CubeTable(model) => model.invert(point, target),
         }
     }
 
@@ -143,7 +151,16 @@ impl FrictionModel for AnyModel {
             AnyModel::ExpCoulomb(model) => model.invert_from(point, target, start),
             AnyModel::Dahl(model) => model.invert_from(point, target, start),
             AnyModel::Cube(model) => model.invert_from(point, target, start),
+            AnyModel::CubeTable(model) => model.invert_from(point, target, start),
         }
+    }
+}
+
+/// The scene kind of a cube model, from its contact.
+fn cube_kind(model: &CubeModel) -> ModelKind {
+    match model.scene().contact().scene().kind {
+        ContactKind::Elastic => ModelKind::CubeElastic,
+        ContactKind::ElasticPlastic => ModelKind::CubeElasticPlastic,
     }
 }
 
@@ -220,6 +237,16 @@ mod tests {
         let cube = AnyModel::new(horn, &horn.plant).expect("cube");
         let ratio = cube.ratio(&point(40.0, 0.005), Q1_31::MAX).expect("ratio");
         assert!((ratio.to_f64() - 0.4806).abs() < 2e-3, "{ratio:?}");
+    }
+
+    /// What a plant or controller holds by value: the table's fixed capacity is the bulk.
+    #[test]
+    fn size() {
+        let size = core::mem::size_of::<AnyModel>();
+        let table = core::mem::size_of::<CubeTable>();
+        assert!(table >= 4 * crate::model::cube_table::MAX_NODES, "{table}");
+        assert!(size <= table + 64, "{size} vs {table}");
+        assert!(size <= 2304, "{size}");
     }
 
     #[test]

@@ -16,6 +16,7 @@ use crate::model::contact::{ContactKind, ContactParams, EStarRule};
 use crate::model::coulomb::{CoulombConstants, CoulombModel};
 use crate::model::cube::{CubeOptions, CubeParams};
 use crate::model::cube_model::CubeModel;
+use crate::model::cube_table::CubeTable;
 use crate::model::dahl::DahlParams;
 use crate::model::dahl_steady::DahlModel;
 use crate::model::horn::UPhase;
@@ -103,8 +104,8 @@ pub fn cube_params(
     })
 }
 
-/// The fixed-point model of a model-level `variant` (Coulomb, Dahl steady, cube) for `scene`,
-/// as the controller runs it. Errors: a kernel variant (`OutOfDomain` on "variant"), the
+/// The fixed-point model of a model-level `variant` (Coulomb, Dahl steady, cube, tabulated
+/// cube over the scene's `contents.load_range_n`) for `scene`, as the controller runs it. Errors: a kernel variant (`OutOfDomain` on "variant"), the
 /// spec lacking the level's parameters, or the model's own validation.
 pub fn fixed_model(scene: &Scene<'_>, variant: &Variant) -> Result<AnyModel, ModelError> {
     let frequency_hz = scene.transducer.drive_hz;
@@ -139,7 +140,18 @@ pub fn fixed_model(scene: &Scene<'_>, variant: &Variant) -> Result<AnyModel, Mod
                 u_phase: UPhase::InPhase,
                 quadrature_points: p.points,
             };
-            Ok(AnyModel::Cube(CubeModel::new(&params, &options)?))
+            let exact = CubeModel::new(&params, &options)?;
+            if variant.table == 0 {
+                return Ok(AnyModel::Cube(exact));
+            }
+            // The table covers the load range the scene states it contains (widened by the
+            // table's margin); loads outside it run `exact`.
+            let range = (scene.contents.load_min_n, scene.contents.load_max_n);
+            Ok(AnyModel::CubeTable(CubeTable::new(
+                exact,
+                range,
+                usize::from(variant.table),
+            )?))
         }
     }
 }

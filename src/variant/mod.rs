@@ -5,8 +5,10 @@
 //! A [`Variant`] is a fidelity level ([`Fidelity`]: the Littmann closed form, one exact Dahl
 //! update, the Coulomb model, the Dahl steady state, the cube model with elastic or
 //! elastic-plastic contact) in a numeric form ([`Form`]: the project's fixed point, `f32` with
-//! `micromath`'s fast approximations, `f32` with `libm`, `f64` with `libm`) with its knob (the
-//! quadrature points of the Dahl and cube averages). [`CATALOGUE`] lists every variant the
+//! `micromath`'s fast approximations, `f32` with `libm`, `f64` with `libm`) with its knobs (the
+//! quadrature points of the Dahl and cube averages; for the cube models, the size of a table
+//! of F'/F over (ln load, amplitude) interpolated instead of evaluating the quadrature,
+//! [`crate::model::cube_table`]). [`CATALOGUE`] lists every variant the
 //! measurement covers; [`Model`] and [`Kernel`] evaluate one.
 //!
 //! - The fixed-point forms are the models of [`crate::model`], built as the controller builds
@@ -137,8 +139,13 @@ pub struct Variant {
     /// The arithmetic.
     pub form: Form,
     /// Quadrature points per average (Dahl: nodes per period, even, 4..=4096; cube: points of
-    /// the Gauss-Legendre rule over the slip half-period, 1..=64); 0 where there is none.
+    /// the Gauss-Legendre rule over the slip half-period, 1..=64); 0 where there is none. For
+    /// a table variant, the quadrature its nodes are computed with.
     pub points: u16,
+    /// Nodes per axis of a table of F'/F over (ln load, amplitude) built at scene start and
+    /// interpolated bilinearly ([`crate::model::cube_table`]: 5, 9 or 17, fixed point, cube
+    /// models only); 0 for a variant that evaluates its model directly.
+    pub table: u8,
 }
 
 #[cfg(feature = "defmt")]
@@ -149,12 +156,13 @@ impl defmt::Format for Variant {
 }
 
 macro_rules! variants {
-    ($($name:literal => $fidelity:ident, $form:ident, $points:literal;)*) => {
+    ($($name:literal => $fidelity:ident, $form:ident, $points:literal $(, T $table:literal)?;)*) => {
         &[$(Variant {
             name: $name,
             fidelity: Fidelity::$fidelity,
             form: Form::$form,
             points: $points,
+            table: 0 $(+ $table)?,
         }),*]
     };
 }
@@ -202,6 +210,9 @@ pub const CATALOGUE: &[Variant] = variants! {
     "cube el N=32 f32 micromath" => CubeElastic, F32Micromath, 32;
     "cube el N=32 f32 libm" => CubeElastic, F32Libm, 32;
     "cube el N=32 f64" => CubeElastic, F64, 32;
+    "cube el T=5x5" => CubeElastic, Fixed, 16, T 5;
+    "cube el T=9x9" => CubeElastic, Fixed, 16, T 9;
+    "cube el T=17x17" => CubeElastic, Fixed, 16, T 17;
     "cube ep N=4" => CubeElasticPlastic, Fixed, 4;
     "cube ep N=4 f32 micromath" => CubeElasticPlastic, F32Micromath, 4;
     "cube ep N=4 f32 libm" => CubeElasticPlastic, F32Libm, 4;
@@ -218,6 +229,9 @@ pub const CATALOGUE: &[Variant] = variants! {
     "cube ep N=32 f32 micromath" => CubeElasticPlastic, F32Micromath, 32;
     "cube ep N=32 f32 libm" => CubeElasticPlastic, F32Libm, 32;
     "cube ep N=32 f64" => CubeElasticPlastic, F64, 32;
+    "cube ep T=5x5" => CubeElasticPlastic, Fixed, 16, T 5;
+    "cube ep T=9x9" => CubeElasticPlastic, Fixed, 16, T 9;
+    "cube ep T=17x17" => CubeElasticPlastic, Fixed, 16, T 17;
 };
 
 /// The variant named `name`, if catalogued.
@@ -225,40 +239,69 @@ pub fn find(name: &str) -> Option<&'static Variant> {
     CATALOGUE.iter().find(|variant| variant.name == name)
 }
 
-/// The variant of `fidelity` in `form` with `points` quadrature points, if catalogued.
+/// The variant of `fidelity` in `form` with `points` quadrature points evaluated directly (no
+/// table), if catalogued.
 pub fn lookup(fidelity: Fidelity, form: Form, points: u16) -> Option<&'static Variant> {
     CATALOGUE
         .iter()
-        .find(|v| v.fidelity == fidelity && v.form == form && v.points == points)
+        .find(|v| v.fidelity == fidelity && v.form == form && v.points == points && v.table == 0)
+}
+
+/// The table variant of `fidelity` with `side` nodes per axis, if catalogued.
+pub fn lookup_table(fidelity: Fidelity, side: u8) -> Option<&'static Variant> {
+    CATALOGUE
+        .iter()
+        .find(|v| v.fidelity == fidelity && v.table == side && side > 0)
 }
 
 impl Variant {
-    /// The `f64` variant of the same fidelity and knob: the denominator of the host time ratio.
+    /// The `f64` variant of the same fidelity and quadrature, evaluated directly: the
+    /// denominator of the host time ratio (for a table variant, the `f64` form of the exact
+    /// model its table is built from).
     pub fn f64_twin(&self) -> Option<&'static Variant> {
         lookup(self.fidelity, Form::F64, self.points)
+    }
+
+    /// The form for reports: the numeric form, and whether the model is tabulated.
+    pub const fn form_name(&self) -> &'static str {
+        if self.table > 0 {
+            "fixed point table"
+        } else {
+            self.form.describe()
+        }
     }
 }
 
 /// Names of the control-step measurements of the QEMU benchmark build, one per fidelity level
-/// the controller can run, with the scene each is timed on and the fidelity's model at the
-/// knob `crate::plant::AnyModel::new` uses (Dahl N = 64, cube N = 16). The first is the
-/// default fidelity (the `reference` scene's Coulomb controller).
-pub const CONTROL_STEPS: &[(&str, &str, Fidelity)] = &[
-    ("control step", "reference", Fidelity::Coulomb),
+/// the controller can run, with the scene each is timed on, the fidelity, and the table side
+/// (nodes per axis; 0: the fidelity's model at the knob `crate::plant::AnyModel::new` uses,
+/// Dahl N = 64, cube N = 16; otherwise the table variant of that side, [`lookup_table`]). The
+/// first is the default fidelity (the `reference` scene's Coulomb controller).
+pub const CONTROL_STEPS: &[(&str, &str, Fidelity, u8)] = &[
+    ("control step", "reference", Fidelity::Coulomb, 0),
     (
         "control step Dahl steady N=64",
         "reference",
         Fidelity::DahlSteady,
+        0,
     ),
     (
         "control step cube el N=16",
         "load-ramp",
         Fidelity::CubeElastic,
+        0,
     ),
     (
         "control step cube ep N=16",
         "load-ramp",
         Fidelity::CubeElasticPlastic,
+        0,
+    ),
+    (
+        "control step cube ep T=17x17",
+        "load-ramp",
+        Fidelity::CubeElasticPlastic,
+        17,
     ),
 ];
 
@@ -269,7 +312,9 @@ mod tests {
     #[test]
     fn names_are_unique_and_say_what_the_variant_is() {
         for (i, v) in CATALOGUE.iter().enumerate() {
-            let knob = if v.points > 0 {
+            let knob = if v.table > 0 {
+                format!(" T={}x{}", v.table, v.table)
+            } else if v.points > 0 {
                 format!(" N={}", v.points)
             } else {
                 String::new()
@@ -278,13 +323,19 @@ mod tests {
             assert_eq!(v.name, want);
             assert!(CATALOGUE[..i].iter().all(|w| w.name != v.name));
             assert_eq!(find(v.name), Some(v));
-            assert_eq!(lookup(v.fidelity, v.form, v.points), Some(v));
+            if v.table > 0 {
+                assert_eq!(lookup_table(v.fidelity, v.table), Some(v));
+                assert_eq!(v.form, Form::Fixed, "{}: tables are fixed point", v.name);
+            } else {
+                assert_eq!(lookup(v.fidelity, v.form, v.points), Some(v));
+            }
         }
         // The named rows exist.
         for name in ["Littmann closed form", "Dahl update", "cube ep N=16"] {
             assert_eq!(find(name).map(|v| v.form), Some(Form::Fixed), "{name}");
         }
         assert!(find("cube ep N=17").is_none());
+        assert!(lookup_table(Fidelity::CubeElasticPlastic, 0).is_none());
     }
 
     #[test]
@@ -292,6 +343,13 @@ mod tests {
         for v in CATALOGUE {
             let twin = v.f64_twin().expect(v.name);
             assert_eq!((twin.fidelity, twin.points), (v.fidelity, v.points));
+            assert_eq!(twin.table, 0);
+            if v.table > 0 {
+                // Tables exist in fixed point only: the controller's form (a float table
+                // would measure the same interpolation in other arithmetic).
+                assert_eq!(v.fidelity.family(), Family::Cube, "{}", v.name);
+                continue;
+            }
             for form in [Form::Fixed, Form::F32Micromath, Form::F32Libm, Form::F64] {
                 assert!(lookup(v.fidelity, form, v.points).is_some(), "{}", v.name);
             }

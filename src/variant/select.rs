@@ -14,9 +14,10 @@
 //!    it is chosen when its measured error against the elastic-plastic reference over the
 //!    scene's load range meets the budget (and it is not dearer).
 //! 3. Among the candidates (fixed point, the required level or a reduced one in the same family,
-//!    every quadrature knob) the errors are measured against the required level's exact `f64`
-//!    model; the cheapest in Cortex-M4 instructions that meets the budget wins, ties going to
-//!    the lower level (fewer parts). When none meets it, the most accurate variant of the
+//!    every quadrature knob and table size) the errors are measured against the required
+//!    level's exact `f64` model; the cheapest in Cortex-M4 instructions that meets the budget
+//!    wins, costs within [`COST_RESOLUTION`] of it counting as ties, which go to the lower level
+//!    (fewer parts), then to the more accurate (the table sizes cost the same per evaluation). When none meets it, the most accurate variant of the
 //!    required level is taken and the reason says so.
 //!
 //! Only fixed-point variants are candidates: the controller's model interface
@@ -37,6 +38,11 @@ use super::{CATALOGUE, Family, Fidelity, Form, Variant, table};
 use crate::model::ModelError;
 use crate::plant::AnyModel;
 use crate::scene::{ModelKind, ModelSpec, Scene};
+
+/// Instructions per evaluation below which two measured costs are not told apart: the QEMU
+/// counts' SysTick rounding is up to 0.3 instructions per call for the cheap variants
+/// (`board/qemu/src/bench.rs`).
+pub const COST_RESOLUTION: f32 = 1.0;
 
 /// Measured cost of one variant: instructions per evaluation on the Cortex-M4 instruction set
 /// (QEMU, `-icount shift=0`, averaged over the variant's grid points).
@@ -264,10 +270,24 @@ pub fn select_from(scene: &Scene<'_>, measured: &Measurements) -> Selection {
     };
     let budget = scene.accuracy.model_pct as f32;
     let within = |c: &Candidate| 100.0 * c.error.max_error <= budget;
-    let cheapest = candidates().filter(within).min_by(|a, b| {
-        a.instructions
-            .total_cmp(&b.instructions)
-            .then(a.variant.fidelity.cmp(&b.variant.fidelity))
+    // Costs within the counts' resolution of the cheapest are equal (the table sizes cost the
+    // same per evaluation, up to the SysTick rounding): among them, the lower level, then the
+    // more accurate.
+    let least = candidates()
+        .filter(within)
+        .map(|c| c.instructions)
+        .min_by(f32::total_cmp);
+    let cheapest = least.and_then(|least| {
+        candidates()
+            .filter(within)
+            .filter(|c| c.instructions <= least + COST_RESOLUTION)
+            .min_by(|a, b| {
+                a.variant
+                    .fidelity
+                    .cmp(&b.variant.fidelity)
+                    .then(a.error.max_error.total_cmp(&b.error.max_error))
+                    .then(a.instructions.total_cmp(&b.instructions))
+            })
     });
     let count = candidates().count();
     if count == 0 {

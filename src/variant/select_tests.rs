@@ -121,6 +121,45 @@ fn elastic_contact_beyond_budget_keeps_the_plastic_terms() {
 }
 
 #[test]
+fn table_sizes_within_the_count_resolution_tie_and_the_more_accurate_wins() {
+    // The table sizes cost the same per evaluation up to the SysTick rounding: 5 x 5 misses
+    // the 0.5 % budget, 9 x 9 and 17 x 17 meet it 0.3 instructions apart; the elastic table
+    // misses it. The more accurate 17 x 17 wins the tie; a real saving (N=4 at 200) would not
+    // be a tie.
+    let costs = vec![
+        ("cube el T=17x17", 351.0),
+        ("cube ep T=5x5", 351.2),
+        ("cube ep T=9x9", 351.5),
+        ("cube ep T=17x17", 351.8),
+        ("cube ep N=16", 1400.0),
+    ];
+    let errors = [
+        ("load-ramp", "cube el T=17x17", EP, 0.017),
+        ("load-ramp", "cube ep T=5x5", EP, 0.006),
+        ("load-ramp", "cube ep T=9x9", EP, 0.0014),
+        ("load-ramp", "cube ep T=17x17", EP, 0.0004),
+        ("load-ramp", "cube ep N=16", EP, 0.000_001),
+    ];
+    let scene = find("load-ramp").unwrap();
+    let s = select_from(scene, &measured(&costs, &errors));
+    assert_eq!(s.variant.map(|v| v.name), Some("cube ep T=17x17"));
+    let model = s.build(scene).unwrap();
+    assert!(matches!(model, AnyModel::CubeTable(ref t) if t.side() == 17));
+    // Dearer by more than the resolution: the cheaper 9 x 9 wins.
+    let mut dearer = costs.clone();
+    dearer[3].1 = 353.0;
+    let s = select_from(scene, &measured(&dearer, &errors));
+    assert_eq!(s.variant.map(|v| v.name), Some("cube ep T=9x9"));
+    // A cheaper exact variant within budget beats every table.
+    let mut cheaper = costs.clone();
+    cheaper.push(("cube ep N=4", 200.0));
+    let mut with_n4 = errors.to_vec();
+    with_n4.push(("load-ramp", "cube ep N=4", EP, 0.0002));
+    let s = select_from(scene, &measured(&cheaper, &with_n4));
+    assert_eq!(s.variant.map(|v| v.name), Some("cube ep N=4"));
+}
+
+#[test]
 fn when_nothing_meets_the_budget_the_most_accurate_required_level_is_taken() {
     let m = measured(
         &cube_costs(),

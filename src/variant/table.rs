@@ -17,27 +17,27 @@ pub static MEASURED: Measurements = Measurements {
 static COSTS: &[Cost] = &[
     Cost {
         variant: "Littmann closed form",
-        instructions: 45.093,
+        instructions: 45.169,
     },
     Cost {
         variant: "Littmann closed form f32 micromath",
-        instructions: 33.891,
+        instructions: 33.872,
     },
     Cost {
         variant: "Littmann closed form f32 libm",
-        instructions: 417.788,
+        instructions: 417.769,
     },
     Cost {
         variant: "Littmann closed form f64",
-        instructions: 3356.036,
+        instructions: 3355.998,
     },
     Cost {
         variant: "Dahl update",
-        instructions: 43.863,
+        instructions: 43.897,
     },
     Cost {
         variant: "Dahl update f32 micromath",
-        instructions: 107.282,
+        instructions: 107.247,
     },
     Cost {
         variant: "Dahl update f32 libm",
@@ -45,83 +45,83 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl update f64",
-        instructions: 2228.205,
+        instructions: 2228.17,
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 287.098,
+        instructions: 295.246,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 68.95,
+        instructions: 68.765,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 242.777,
+        instructions: 242.839,
     },
     Cost {
         variant: "Coulomb ratio f64",
-        instructions: 2667.777,
+        instructions: 2667.716,
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11284.375,
+        instructions: 11293.75,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 6010.208,
+        instructions: 6010.277,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 32638.473,
+        instructions: 32638.332,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 150917.16,
+        instructions: 150917.22,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20111.111,
+        instructions: 20120.486,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
-        instructions: 11569.652,
+        instructions: 11569.93,
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 60074.027,
+        instructions: 60074.445,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 276594.03,
+        instructions: 276594.66,
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 37608.54,
+        instructions: 37617.36,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22717.777,
+        instructions: 22717.916,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 114684.445,
+        instructions: 114686.59,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 523935.75,
+        instructions: 523936.66,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 530.0,
+        instructions: 591.818,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
-        instructions: 378.03,
+        instructions: 378.181,
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 260.151,
+        instructions: 260.303,
     },
     Cost {
         variant: "cube el N=4 f64",
@@ -129,7 +129,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 763.939,
+        instructions: 829.696,
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
@@ -137,15 +137,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8 f32 libm",
-        instructions: 388.484,
+        instructions: 388.333,
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15225.151,
+        instructions: 15225.0,
     },
     Cost {
         variant: "cube el N=16",
-        instructions: 1231.969,
+        instructions: 1305.757,
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
@@ -153,31 +153,43 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=16 f32 libm",
-        instructions: 646.969,
+        instructions: 647.121,
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26871.666,
+        instructions: 26871.516,
     },
     Cost {
         variant: "cube el N=32",
-        instructions: 2167.878,
+        instructions: 2257.878,
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.666,
+        instructions: 2161.363,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
-        instructions: 1162.878,
+        instructions: 1163.03,
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50107.273,
+        instructions: 50107.12,
+    },
+    Cost {
+        variant: "cube el T=5x5",
+        instructions: 282.727,
+    },
+    Cost {
+        variant: "cube el T=9x9",
+        instructions: 282.575,
+    },
+    Cost {
+        variant: "cube el T=17x17",
+        instructions: 282.727,
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 530.0,
+        instructions: 591.666,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
@@ -185,15 +197,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
-        instructions: 260.151,
+        instructions: 260.303,
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9412.575,
+        instructions: 9412.272,
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 763.787,
+        instructions: 830.0,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
@@ -209,15 +221,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1231.666,
+        instructions: 1305.757,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
-        instructions: 1141.666,
+        instructions: 1141.818,
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 647.121,
+        instructions: 646.969,
     },
     Cost {
         variant: "cube ep N=16 f64",
@@ -225,11 +237,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32",
-        instructions: 2167.878,
+        instructions: 2258.03,
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
-        instructions: 2161.363,
+        instructions: 2161.666,
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
@@ -237,7 +249,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50094.395,
+        instructions: 50095.605,
+    },
+    Cost {
+        variant: "cube ep T=5x5",
+        instructions: 282.878,
+    },
+    Cost {
+        variant: "cube ep T=9x9",
+        instructions: 283.03,
+    },
+    Cost {
+        variant: "cube ep T=17x17",
+        instructions: 282.575,
     },
 ];
 
@@ -281,6 +305,27 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "horn-al-ss",
+        variant: "cube el T=5x5",
+        reference: Fidelity::CubeElastic,
+        max_error: 0.00541,
+        points: 120,
+    },
+    SceneError {
+        scene: "horn-al-ss",
+        variant: "cube el T=9x9",
+        reference: Fidelity::CubeElastic,
+        max_error: 0.0013,
+        points: 120,
+    },
+    SceneError {
+        scene: "horn-al-ss",
+        variant: "cube el T=17x17",
+        reference: Fidelity::CubeElastic,
+        max_error: 0.000331,
+        points: 120,
+    },
+    SceneError {
+        scene: "horn-al-ss",
         variant: "cube el N=4",
         reference: Fidelity::CubeElasticPlastic,
         max_error: 0.0171,
@@ -309,6 +354,27 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "horn-al-ss",
+        variant: "cube el T=5x5",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.0191,
+        points: 120,
+    },
+    SceneError {
+        scene: "horn-al-ss",
+        variant: "cube el T=9x9",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.0174,
+        points: 120,
+    },
+    SceneError {
+        scene: "horn-al-ss",
+        variant: "cube el T=17x17",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.017,
+        points: 120,
+    },
+    SceneError {
+        scene: "horn-al-ss",
         variant: "cube ep N=4",
         reference: Fidelity::CubeElasticPlastic,
         max_error: 0.000163,
@@ -333,6 +399,27 @@ static ERRORS: &[SceneError] = &[
         variant: "cube ep N=32",
         reference: Fidelity::CubeElasticPlastic,
         max_error: 7.4e-8,
+        points: 120,
+    },
+    SceneError {
+        scene: "horn-al-ss",
+        variant: "cube ep T=5x5",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.00602,
+        points: 120,
+    },
+    SceneError {
+        scene: "horn-al-ss",
+        variant: "cube ep T=9x9",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.00145,
+        points: 120,
+    },
+    SceneError {
+        scene: "horn-al-ss",
+        variant: "cube ep T=17x17",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.000371,
         points: 120,
     },
     SceneError {
@@ -365,6 +452,27 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "horn-ss-ss",
+        variant: "cube el T=5x5",
+        reference: Fidelity::CubeElastic,
+        max_error: 0.00484,
+        points: 24,
+    },
+    SceneError {
+        scene: "horn-ss-ss",
+        variant: "cube el T=9x9",
+        reference: Fidelity::CubeElastic,
+        max_error: 0.00116,
+        points: 24,
+    },
+    SceneError {
+        scene: "horn-ss-ss",
+        variant: "cube el T=17x17",
+        reference: Fidelity::CubeElastic,
+        max_error: 0.000294,
+        points: 24,
+    },
+    SceneError {
+        scene: "horn-ss-ss",
         variant: "cube el N=4",
         reference: Fidelity::CubeElasticPlastic,
         max_error: 0.0166,
@@ -393,6 +501,27 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "horn-ss-ss",
+        variant: "cube el T=5x5",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.0184,
+        points: 24,
+    },
+    SceneError {
+        scene: "horn-ss-ss",
+        variant: "cube el T=9x9",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.0168,
+        points: 24,
+    },
+    SceneError {
+        scene: "horn-ss-ss",
+        variant: "cube el T=17x17",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.0165,
+        points: 24,
+    },
+    SceneError {
+        scene: "horn-ss-ss",
         variant: "cube ep N=4",
         reference: Fidelity::CubeElasticPlastic,
         max_error: 0.000151,
@@ -417,6 +546,27 @@ static ERRORS: &[SceneError] = &[
         variant: "cube ep N=32",
         reference: Fidelity::CubeElasticPlastic,
         max_error: 7.04e-8,
+        points: 24,
+    },
+    SceneError {
+        scene: "horn-ss-ss",
+        variant: "cube ep T=5x5",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.00538,
+        points: 24,
+    },
+    SceneError {
+        scene: "horn-ss-ss",
+        variant: "cube ep T=9x9",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.00129,
+        points: 24,
+    },
+    SceneError {
+        scene: "horn-ss-ss",
+        variant: "cube ep T=17x17",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.000329,
         points: 24,
     },
     SceneError {
@@ -449,6 +599,27 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "load-ramp",
+        variant: "cube el T=5x5",
+        reference: Fidelity::CubeElastic,
+        max_error: 0.00541,
+        points: 120,
+    },
+    SceneError {
+        scene: "load-ramp",
+        variant: "cube el T=9x9",
+        reference: Fidelity::CubeElastic,
+        max_error: 0.0013,
+        points: 120,
+    },
+    SceneError {
+        scene: "load-ramp",
+        variant: "cube el T=17x17",
+        reference: Fidelity::CubeElastic,
+        max_error: 0.000331,
+        points: 120,
+    },
+    SceneError {
+        scene: "load-ramp",
         variant: "cube el N=4",
         reference: Fidelity::CubeElasticPlastic,
         max_error: 0.0171,
@@ -477,6 +648,27 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "load-ramp",
+        variant: "cube el T=5x5",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.0191,
+        points: 120,
+    },
+    SceneError {
+        scene: "load-ramp",
+        variant: "cube el T=9x9",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.0174,
+        points: 120,
+    },
+    SceneError {
+        scene: "load-ramp",
+        variant: "cube el T=17x17",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.017,
+        points: 120,
+    },
+    SceneError {
+        scene: "load-ramp",
         variant: "cube ep N=4",
         reference: Fidelity::CubeElasticPlastic,
         max_error: 0.000163,
@@ -501,6 +693,27 @@ static ERRORS: &[SceneError] = &[
         variant: "cube ep N=32",
         reference: Fidelity::CubeElasticPlastic,
         max_error: 7.4e-8,
+        points: 120,
+    },
+    SceneError {
+        scene: "load-ramp",
+        variant: "cube ep T=5x5",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.00602,
+        points: 120,
+    },
+    SceneError {
+        scene: "load-ramp",
+        variant: "cube ep T=9x9",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.00145,
+        points: 120,
+    },
+    SceneError {
+        scene: "load-ramp",
+        variant: "cube ep T=17x17",
+        reference: Fidelity::CubeElasticPlastic,
+        max_error: 0.000371,
         points: 120,
     },
     SceneError {

@@ -26,6 +26,9 @@
 //! (`ClosedLoop::with_model`, not the variant the scene selects); the plant's phase is not
 //! timed.
 //!
+//! The table variants' build (`CubeTable::new`, at scene start) is timed once per cube scene:
+//! `bench build NAME: ...`, the mean over the scenes.
+//!
 //! Output, one line per measurement (parsed by `sonolube speed`):
 //! `bench NAME: N.NNN instructions per call (C calls)`.
 
@@ -33,10 +36,12 @@ use core::hint::black_box;
 use core::mem::MaybeUninit;
 
 use sonolube::fx::Q1_31;
+use sonolube::model::cube_table::CubeTable;
 use sonolube::model::{FrictionModel, OperatingPoint, dahl, littmann};
 use sonolube::plant::AnyModel;
 use sonolube::scene::{ModelKind, ModelSpec, SCENES, Scene};
 use sonolube::sim::{ClosedLoop, SimError};
+use sonolube::variant::fixed::fixed_model;
 use sonolube::variant::float_inplane::{dahl_update, littmann as float_littmann};
 use sonolube::variant::grid::{
     DAHL_UPDATE_POINTS, DahlUpdateInput, LITTMANN_POINTS, SceneGrid, dahl_update_input,
@@ -44,7 +49,9 @@ use sonolube::variant::grid::{
 };
 use sonolube::variant::model::FloatModel;
 use sonolube::variant::real::{Libm, Maths, Micromath, Real};
-use sonolube::variant::{CATALOGUE, CONTROL_STEPS, Family, Fidelity, Form, Model, Variant};
+use sonolube::variant::{
+    CATALOGUE, CONTROL_STEPS, Family, Fidelity, Form, Model, Variant, lookup_table,
+};
 
 use crate::{time_driver, watchdog};
 
@@ -272,6 +279,53 @@ fn model(variant: &Variant, shift: u32) -> bool {
     true
 }
 
+/// Times building the table of a table variant (`CubeTable::new` on a copy of the exact model,
+/// the copy included: about 1 KB, a few hundred instructions) once for every cube scene that can
+/// build it; prints `bench build NAME: ...`. False if a table cannot be built.
+fn table_build(variant: &Variant, shift: u32) -> bool {
+    let mut tally = Tally::default();
+    let exact = Variant {
+        table: 0,
+        ..*variant
+    };
+    for scene in SCENES.iter().filter(|s| family(s) == Family::Cube) {
+        if !sonolube::variant::fixed::buildable(scene, variant.fidelity) {
+            continue;
+        }
+        let Ok(AnyModel::Cube(model)) = fixed_model(scene, &exact) else {
+            defmt::error!("bench build {=str}: scene {=str}", variant.name, scene.name);
+            return false;
+        };
+        let range = (scene.contents.load_min_n, scene.contents.load_max_n);
+        watchdog::feed();
+        let start = time_driver::cycles();
+        let built = black_box(CubeTable::new(
+            black_box(model.clone()),
+            range,
+            usize::from(variant.table),
+        ));
+        tally.cycles += time_driver::cycles().saturating_sub(start) as i64;
+        tally.calls += 1;
+        watchdog::feed();
+        if built.is_err() {
+            defmt::error!("bench build {=str}: scene {=str}", variant.name, scene.name);
+            return false;
+        }
+    }
+    let Some(milli) = milli_instructions(tally.cycles, tally.calls, shift) else {
+        defmt::error!("bench build {=str}: no scene", variant.name);
+        return false;
+    };
+    defmt::info!(
+        "bench build {=str}: {=u64}.{=u64:03} instructions per call ({=u64} calls)",
+        variant.name,
+        milli / 1000,
+        milli % 1000,
+        tally.calls
+    );
+    true
+}
+
 /// The controller model kind of a fidelity level.
 fn kind(fidelity: Fidelity) -> Option<ModelKind> {
     match fidelity {
@@ -285,7 +339,7 @@ fn kind(fidelity: Fidelity) -> Option<ModelKind> {
 
 /// Times the control phase of `scene_name` run with a controller model of `fidelity`; false if
 /// the run cannot be built.
-fn control_step(name: &str, scene_name: &str, fidelity: Fidelity, shift: u32) -> bool {
+fn control_step(name: &str, scene_name: &str, fidelity: Fidelity, table: u8, shift: u32) -> bool {
     let (Some(scene), Some(kind)) = (sonolube::scene::find(scene_name), kind(fidelity)) else {
         defmt::error!("bench {=str}: no scene {=str}", name, scene_name);
         return false;
@@ -297,9 +351,13 @@ fn control_step(name: &str, scene_name: &str, fidelity: Fidelity, shift: u32) ->
         },
         ..*scene
     };
-    // The level's own model at its default knob, not the variant the scene selects: the row
-    // times the level.
-    let run = AnyModel::new(&scene, &scene.controller)
+    // The level's own model at its default knob (or the named table variant), not the variant
+    // the scene selects: the row times the level.
+    let model = match lookup_table(fidelity, table) {
+        Some(variant) => fixed_model(&scene, variant),
+        None => AnyModel::new(&scene, &scene.controller),
+    };
+    let run = model
         .map_err(SimError::Model)
         .and_then(|model| ClosedLoop::with_model(&scene, model));
     let mut closed_loop = match run {
@@ -357,8 +415,12 @@ pub fn run() -> bool {
             ok &= model(variant, shift);
         }
     }
-    for &(name, scene, fidelity) in CONTROL_STEPS {
-        ok &= control_step(name, scene, fidelity, shift);
+    for variant in CATALOGUE.iter().filter(|v| v.table > 0) {
+        watchdog::feed();
+        ok &= table_build(variant, shift);
+    }
+    for &(name, scene, fidelity, table) in CONTROL_STEPS {
+        ok &= control_step(name, scene, fidelity, table, shift);
     }
     ok
 }

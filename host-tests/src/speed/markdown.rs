@@ -3,13 +3,14 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
+use sonolube::model::cube_table::MAX_NODES;
 use sonolube::scene::SCENES;
 use sonolube::variant::select::{Measurements, select_from};
 use sonolube::variant::{CATALOGUE, CONTROL_STEPS, Fidelity, find, grid};
 
 use super::errors::{Errors, Stats};
 use super::fronts::{Set, Standing, is_kernel, standing};
-use super::qemu::Counts;
+use super::qemu::{Counts, build_name};
 use super::table_rs::COMMAND;
 use super::timing::{SAMPLE_TIME, SAMPLES};
 
@@ -123,11 +124,11 @@ impl Report<'_> {
                 error(stats.rms),
                 stats.points,
                 level_name(v.fidelity),
-                v.form.describe(),
+                v.form_name(),
                 standing_text(standing(self.sets, v)),
             );
         }
-        for &(name, scene, level) in CONTROL_STEPS {
+        for &(name, scene, level, table) in CONTROL_STEPS {
             let (instructions, detail) = match self.counts.get(name) {
                 Some(c) => (
                     thousands(c.instructions),
@@ -141,8 +142,35 @@ impl Report<'_> {
             };
             let _ = writeln!(
                 s,
-                "| {name} | {instructions} | - | - | - | - | {} (whole control step: {detail}) | fixed point | - |",
-                level_name(level)
+                "| {name} | {instructions} | - | - | - | - | {} (whole control step: {detail}) | {} | - |",
+                level_name(level),
+                if table > 0 {
+                    "fixed point table"
+                } else {
+                    "fixed point"
+                }
+            );
+        }
+    }
+
+    /// What building each table costs at scene start, and its storage.
+    fn table_builds(&self, s: &mut String) {
+        let _ = writeln!(
+            s,
+            "| variant | nodes | instructions to build (mean over the cube scenes) | at 170 MHz, 1 cycle per instruction | table storage |\n|---|---:|---:|---:|---|"
+        );
+        for v in CATALOGUE.iter().filter(|v| v.table > 0) {
+            let nodes = usize::from(v.table).pow(2);
+            let count = self.counts.get(&build_name(v.name));
+            let _ = writeln!(
+                s,
+                "| {} | {nodes} | {} | {} | {} of {} Q2.30 nodes used ({} bytes) |",
+                v.name,
+                count.map_or("-".into(), |c| thousands(c.instructions)),
+                count.map_or("-".into(), |c| format!("{:.2} ms", c.instructions / 170e3)),
+                thousands(nodes as f64),
+                thousands(MAX_NODES as f64),
+                thousands(4.0 * MAX_NODES as f64),
             );
         }
     }
@@ -304,8 +332,23 @@ impl Report<'_> {
              dominated in every one. The control-step rows time the whole step (target, \
              sensing, estimate, model and its inverse, controller, drive command) with the \
              level's model at its default knob (the scene's own model, not the variant the \
-             scene selects); their error is that of the model they run.\n"
+             scene selects), or with the table variant they name; their error is that of the \
+             model they run.\n"
         );
+        let _ = writeln!(
+            s,
+            "## Table builds\n\n\
+             A table variant (`T=SxS`) evaluates F'/F by bilinear interpolation in a table of \
+             S x S nodes over (ln load, amplitude) that the controller builds at scene start \
+             from its exact fixed-point model (N = 16, so host and firmware tables are \
+             bit-identical; `sonolube::model::cube_table`). Its per-evaluation cost does not \
+             grow with S; the build does, and so does the accuracy. The storage is fixed: every \
+             table reserves the largest (17 x 17), since a controller holds its model by value \
+             in `AnyModel`. Builds counted in QEMU as above, once per cube scene, the copy of \
+             the exact model included:\n"
+        );
+        self.table_builds(&mut s);
+        s.push('\n');
         let _ = writeln!(s, "## Goals (issue 7)\n");
         self.goals(&mut s);
         let _ = writeln!(
@@ -348,7 +391,11 @@ with `libm`. The float forms (`src/variant/float_*.rs`) run the fixed point's al
 closed forms, same quadrature rules and node counts, same scene constants folded in `f64` at
 scene load), so forms differ in arithmetic and maths library only. Knob: the quadrature points
 N of the Dahl (nodes per period) and cube (Gauss-Legendre points over the slip half-period)
-averages. There are no lookup-table variants: no model here is evaluated from a table.
+averages, and for the cube models the table size S of the `T=SxS` variants (fixed point only):
+F'/F of the exact fixed-point model at N = 16 tabulated at scene start on S x S nodes, ln F_n
+over the scene's `load_range_n` widened by a factor e^(1/8) each side, the amplitude over
+[0, 1], interpolated bilinearly (loads outside the table run the exact model; see
+`sonolube::model::cube_table`). Their `f64` twin for the host time is the exact `N=16 f64`.
 
 **Grids.** Every variant is measured on the same fixed inputs for cost and error
 (`sonolube::variant::grid`): for a model level, each scene's operating grid in the controller's

@@ -2,7 +2,8 @@
 //!
 //! The firmware prints one line per measurement (`board/qemu/src/bench.rs`):
 //! `bench NAME: N.NNN instructions per call (C calls[, longest L])`, after defmt-print's
-//! timestamp and level. Other lines are ignored. A name printed twice is an error, and so is a
+//! timestamp and level; the table variants' builds as `bench build NAME: ...`. Other lines
+//! are ignored. A name printed twice is an error, and so is a
 //! catalogued variant or control step without a count (the log is from another build).
 
 use std::collections::BTreeMap;
@@ -68,6 +69,11 @@ fn parse_line(line: &str) -> Option<Result<(String, Count), String>> {
     )
 }
 
+/// The name of a table variant's build measurement (`bench build NAME`, once per cube scene).
+pub fn build_name(variant: &str) -> String {
+    format!("build {variant}")
+}
+
 /// Every count of a log. Errors: a malformed benchmark line, a name twice, or a catalogued
 /// variant or control step missing.
 pub fn parse(log: &str) -> Result<Counts, String> {
@@ -80,10 +86,16 @@ pub fn parse(log: &str) -> Result<Counts, String> {
             }
         }
     }
+    let builds: Vec<String> = CATALOGUE
+        .iter()
+        .filter(|v| v.table > 0)
+        .map(|v| build_name(v.name))
+        .collect();
     let expected = CATALOGUE
         .iter()
         .map(|v| v.name)
-        .chain(CONTROL_STEPS.iter().map(|c| c.0));
+        .chain(CONTROL_STEPS.iter().map(|c| c.0))
+        .chain(builds.iter().map(String::as_str));
     let missing: Vec<&str> = expected.filter(|n| !counts.contains_key(*n)).collect();
     if !missing.is_empty() {
         return Err(format!(
@@ -107,7 +119,13 @@ mod tests {
                 100 + i
             ));
         }
-        for (name, _, _) in CONTROL_STEPS {
+        for v in CATALOGUE.iter().filter(|v| v.table > 0) {
+            log.push_str(&format!(
+                "0.9 INFO  bench build {}: 356000.500 instructions per call (3 calls)\n",
+                v.name
+            ));
+        }
+        for (name, _, _, _) in CONTROL_STEPS {
             log.push_str(&format!(
                 "1.0 INFO  bench {name}: 2764.320 instructions per call (250 calls, longest 3040)\n"
             ));
@@ -118,7 +136,16 @@ mod tests {
     #[test]
     fn parses_every_line_and_requires_every_name() {
         let counts = parse(&full_log()).unwrap();
-        assert_eq!(counts.len(), CATALOGUE.len() + CONTROL_STEPS.len());
+        let tables = CATALOGUE.iter().filter(|v| v.table > 0).count();
+        assert!(tables > 0);
+        assert_eq!(counts.len(), CATALOGUE.len() + CONTROL_STEPS.len() + tables);
+        assert_eq!(counts["build cube ep T=17x17"].calls, 3);
+        let no_build = full_log().replace("bench build cube ep T=9x9:", "bench other:");
+        assert!(
+            parse(&no_build)
+                .unwrap_err()
+                .contains("build cube ep T=9x9")
+        );
         let c = counts["cube ep N=16"];
         assert_eq!(c.calls, 264);
         assert!(c.instructions > 100.0 && c.longest.is_none());

@@ -36,12 +36,14 @@ fn panel(level: Fidelity, errors: &Errors, counts: &Counts) -> String {
     for v in CATALOGUE.iter().filter(|v| v.fidelity == level) {
         let x = counts.get(v.name).map_or(f64::NAN, |c| c.instructions);
         let y = errors.own(v.name).map_or(f64::NAN, |e| e.max);
-        let label = if v.points > 0 {
+        let label = if v.table > 0 {
+            format!("T={}", v.table)
+        } else if v.points > 0 {
             format!("N={}", v.points)
         } else {
             String::new()
         };
-        plot = plot.point(&label, x, y, v.form.describe());
+        plot = plot.point(&label, x, y, v.form_name());
         xy.push((x, y));
     }
     plot.pareto(&pareto_front(&xy)).to_svg()
