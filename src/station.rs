@@ -68,7 +68,8 @@ pub trait CellBench {
 /// Lowest and highest drive frequency a `freq` command may set, cHz (the protocol's range).
 const FREQ_RANGE_CHZ: core::ops::RangeInclusive<u32> = 2_000_000..=6_000_000;
 
-/// The control side of a scene. About 3 KB (the cube model's tables are the bulk).
+/// The control side of a scene. Its size is mostly the model's ([`AnyModel`] holds the largest
+/// variant by value: the tabulated cube model with its exact model and 17 x 17 nodes).
 #[derive(Debug, Clone)]
 pub struct Station {
     model: AnyModel,
