@@ -171,7 +171,8 @@ fn missing(input: &'static str) -> ModelError {
     }
 }
 
-fn contact_params(surface: &RoughSurface) -> ContactParams {
+/// The contact parameters of a scene's rough surface (same fields, the model's names).
+pub fn contact_params(surface: &RoughSurface) -> ContactParams {
     ContactParams {
         roughness_rq: surface.rq_m,
         summit_radius: surface.rs_m,

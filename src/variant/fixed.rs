@@ -12,7 +12,7 @@
 use super::float_cube::FloatCubeParams;
 use super::{Fidelity, Variant};
 use crate::model::ModelError;
-use crate::model::contact::{ContactKind, ContactParams, EStarRule};
+use crate::model::contact::{ContactKind, EStarRule};
 use crate::model::coulomb::{CoulombConstants, CoulombModel};
 use crate::model::cube::{CubeOptions, CubeParams};
 use crate::model::cube_model::CubeModel;
@@ -22,7 +22,8 @@ use crate::model::dahl_steady::DahlModel;
 use crate::model::horn::UPhase;
 use crate::model::quadrature::SlipWindow;
 use crate::plant::AnyModel;
-use crate::scene::{RoughSurface, Scene};
+use crate::plant::any_model::contact_params;
+use crate::scene::Scene;
 
 /// What a scene's controller spec lacks for a fidelity level.
 fn missing(input: &'static str) -> ModelError {
@@ -57,24 +58,6 @@ pub fn dahl_params(scene: &Scene<'_>, points: u32) -> Result<DahlParams, ModelEr
     })
 }
 
-/// The contact parameters of a scene's rough surface (same fields, the model's names).
-pub fn contact_params(surface: &RoughSurface) -> ContactParams {
-    ContactParams {
-        roughness_rq: surface.rq_m,
-        summit_radius: surface.rs_m,
-        nominal_area: surface.nominal_area_m2,
-        asperity_density: surface.asperity_density_per_m2,
-        distribution_c: surface.distribution_c,
-        distribution_lambda: surface.distribution_lambda,
-        young_1: surface.young_1_pa,
-        poisson_1: surface.poisson_1,
-        young_2: surface.young_2_pa,
-        poisson_2: surface.poisson_2,
-        poisson_soft: surface.poisson_soft,
-        yield_strength: surface.yield_strength_pa,
-    }
-}
-
 /// The contact model of a cube fidelity (elastic-plastic for anything else).
 pub fn contact_kind(fidelity: Fidelity) -> ContactKind {
     if fidelity == Fidelity::CubeElastic {
@@ -105,8 +88,9 @@ pub fn cube_params(
 }
 
 /// The fixed-point model of a model-level `variant` (Coulomb, Dahl steady, cube, tabulated
-/// cube over the scene's `contents.load_range_n`) for `scene`, as the controller runs it. Errors: a kernel variant (`OutOfDomain` on "variant"), the
-/// spec lacking the level's parameters, or the model's own validation.
+/// cube over the scene's `contents.load_range_n`) for `scene`, as the controller runs it.
+/// Errors: a kernel variant (`OutOfDomain` on "variant"), the spec lacking the level's
+/// parameters, or the model's own validation.
 pub fn fixed_model(scene: &Scene<'_>, variant: &Variant) -> Result<AnyModel, ModelError> {
     let frequency_hz = scene.transducer.drive_hz;
     let amplitude_m = scene.actuator.full_scale_amplitude_m;

@@ -53,6 +53,23 @@ fn finite<T: Real>(v: T, amplitude: T) -> Result<(), ModelError> {
     Ok(())
 }
 
+/// zeta = |v| / (amplitude v_fs), or `None` when there is no vibration and the contact slides
+/// (F'/F = 1). Errors: negative amplitude, v = 0 without vibration.
+fn zeta<T: Real>(v: T, amplitude: T, full_scale_velocity: T) -> Result<Option<T>, ModelError> {
+    if amplitude < T::ZERO {
+        return Err(negative("amplitude"));
+    }
+    let speed = v.abs();
+    if amplitude == T::ZERO {
+        return if speed > T::ZERO {
+            Ok(None)
+        } else {
+            Err(no_motion())
+        };
+    }
+    Ok(Some(speed / (amplitude * full_scale_velocity)))
+}
+
 fn negative(input: &'static str) -> ModelError {
     ModelError::OutOfDomain {
         input,
@@ -99,18 +116,9 @@ impl<T: Real> FloatCoulomb<T> {
     /// vibration.
     pub fn ratio<M: Maths<T>>(&self, v: T, amplitude: T) -> Result<T, ModelError> {
         finite(v, amplitude)?;
-        if amplitude < T::ZERO {
-            return Err(negative("amplitude"));
-        }
-        let speed = v.abs();
-        if amplitude == T::ZERO {
-            return if speed > T::ZERO {
-                Ok(T::ONE)
-            } else {
-                Err(no_motion())
-            };
-        }
-        let zeta = speed / (amplitude * self.full_scale_velocity);
+        let Some(zeta) = zeta(v, amplitude, self.full_scale_velocity)? else {
+            return Ok(T::ONE); // sliding without vibration: natural friction
+        };
         Ok(littmann::<T, M>(zeta))
     }
 }
@@ -187,18 +195,9 @@ impl<T: Real> FloatDahl<T> {
                 reason: "must be > 0 (F_c = mu W)",
             });
         }
-        if amplitude < T::ZERO {
-            return Err(negative("amplitude"));
-        }
-        let speed = v.abs();
-        if amplitude == T::ZERO {
-            return if speed > T::ZERO {
-                Ok(T::ONE)
-            } else {
-                Err(no_motion())
-            };
-        }
-        let zeta = speed / (amplitude * self.full_scale_velocity);
+        let Some(zeta) = zeta(v, amplitude, self.full_scale_velocity)? else {
+            return Ok(T::ONE); // sliding without vibration: natural friction
+        };
         if zeta >= T::ONE {
             return Ok(T::ONE); // no reversal: f relaxes to sgn v
         }

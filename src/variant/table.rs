@@ -17,11 +17,11 @@ pub static MEASURED: Measurements = Measurements {
 static COSTS: &[Cost] = &[
     Cost {
         variant: "Littmann closed form",
-        instructions: 45.169,
+        instructions: 45.131,
     },
     Cost {
         variant: "Littmann closed form f32 micromath",
-        instructions: 33.872,
+        instructions: 33.853,
     },
     Cost {
         variant: "Littmann closed form f32 libm",
@@ -29,19 +29,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Littmann closed form f64",
-        instructions: 3355.998,
+        instructions: 3356.036,
     },
     Cost {
         variant: "Dahl update",
-        instructions: 43.897,
+        instructions: 43.829,
     },
     Cost {
         variant: "Dahl update f32 micromath",
-        instructions: 107.247,
+        instructions: 107.213,
     },
     Cost {
         variant: "Dahl update f32 libm",
-        instructions: 60.17,
+        instructions: 60.205,
     },
     Cost {
         variant: "Dahl update f64",
@@ -49,11 +49,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 295.246,
+        instructions: 294.876,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 68.765,
+        instructions: 68.703,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
@@ -61,55 +61,55 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Coulomb ratio f64",
-        instructions: 2667.716,
+        instructions: 2700.555,
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11293.75,
+        instructions: 11293.194,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 6010.277,
+        instructions: 6010.347,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 32638.332,
+        instructions: 32638.193,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 150917.22,
+        instructions: 150957.84,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20120.486,
+        instructions: 20120.0,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
-        instructions: 11569.93,
+        instructions: 11569.791,
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 60074.445,
+        instructions: 60074.723,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 276594.66,
+        instructions: 276634.1,
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 37617.36,
+        instructions: 37617.43,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22717.916,
+        instructions: 22718.125,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 114686.59,
+        instructions: 114685.07,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 523936.66,
+        instructions: 523976.88,
     },
     Cost {
         variant: "cube el N=4",
@@ -117,31 +117,31 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
-        instructions: 378.181,
+        instructions: 378.03,
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 260.303,
+        instructions: 260.151,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9421.969,
+        instructions: 9423.939,
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 829.696,
+        instructions: 830.0,
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 632.121,
+        instructions: 631.969,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
-        instructions: 388.333,
+        instructions: 388.484,
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15225.0,
+        instructions: 15228.636,
     },
     Cost {
         variant: "cube el N=16",
@@ -153,27 +153,27 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=16 f32 libm",
-        instructions: 647.121,
+        instructions: 646.969,
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26871.516,
+        instructions: 26879.545,
     },
     Cost {
         variant: "cube el N=32",
-        instructions: 2257.878,
+        instructions: 2257.727,
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.363,
+        instructions: 2161.818,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
-        instructions: 1163.03,
+        instructions: 1162.878,
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50107.12,
+        instructions: 50123.18,
     },
     Cost {
         variant: "cube el T=5x5",
@@ -181,7 +181,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el T=9x9",
-        instructions: 282.575,
+        instructions: 282.727,
     },
     Cost {
         variant: "cube el T=17x17",
@@ -189,27 +189,27 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 591.666,
+        instructions: 591.969,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 377.878,
+        instructions: 378.03,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
-        instructions: 260.303,
+        instructions: 260.454,
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9412.272,
+        instructions: 9414.545,
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 830.0,
+        instructions: 829.696,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 631.666,
+        instructions: 632.121,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
@@ -217,11 +217,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=8 f64",
-        instructions: 15212.121,
+        instructions: 15216.363,
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1305.757,
+        instructions: 1306.212,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
@@ -233,15 +233,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26859.848,
+        instructions: 26867.424,
     },
     Cost {
         variant: "cube ep N=32",
-        instructions: 2258.03,
+        instructions: 2257.727,
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
-        instructions: 2161.666,
+        instructions: 2161.515,
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
@@ -249,15 +249,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50095.605,
+        instructions: 50110.91,
     },
     Cost {
         variant: "cube ep T=5x5",
-        instructions: 282.878,
+        instructions: 282.727,
     },
     Cost {
         variant: "cube ep T=9x9",
-        instructions: 283.03,
+        instructions: 282.575,
     },
     Cost {
         variant: "cube ep T=17x17",
