@@ -15,7 +15,7 @@ use core::sync::atomic::{AtomicBool, Ordering};
 use embassy_stm32::Peri;
 use embassy_stm32::gpio::OutputType;
 use embassy_stm32::pac;
-use embassy_stm32::pac::timer::regs::{ArrDitherCore, CcrDither1ch};
+use embassy_stm32::pac::timer::regs::{ArrDitherCore, Ccr1ch, CcrDither1ch};
 use embassy_stm32::pac::timer::vals::{Bkinp, Bkp, FilterValue, Mms2, Ocm, Ossi, Ossr};
 use embassy_stm32::peripherals::{PA8, PB13, TIM1};
 use embassy_stm32::time::Hertz;
@@ -124,8 +124,11 @@ pub fn write_timing(timing: &DriveTiming, amplitude: Amplitude) {
     tim1.bdtr().modify(|w| w.set_dtg(timing.dead_time().dtg()));
     tim1.arr_dither()
         .write_value(ArrDitherCore(timing.period().arr_register()));
-    tim1.ccr_dither(CH4)
-        .write_value(CcrDither1ch(timing.adc_trigger_compare()));
+    // stm32-metapac models dither-mode CCRs for CH1-2 only (`ccr_dither(n)` asserts n < 2 and
+    // panics at run time for CH4). CCR4 is the same 32-bit register at TIM1 + 0x40 whatever the
+    // mode; in dither mode it holds the 20-bit value (16.4) written here raw through `ccr(3)`.
+    tim1.ccr(CH4)
+        .write_value(Ccr1ch(timing.adc_trigger_compare()));
     set_amplitude(timing, amplitude);
 }
 
