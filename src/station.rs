@@ -6,14 +6,17 @@
 //! [`crate::variant::select`] (the cheapest fixed-point variant whose measured maximum error over
 //! the scene's range meets `accuracy.model_pct`, with the parts the scene does not need left
 //! out; a scene outside the committed table keeps its own model). This is the one place where
-//! the host (`sonolube scene`, [`crate::sim::ClosedLoop`]) and every board build a scene's
+//! the host (`sonolube scene`, `sonolube_sim::ClosedLoop`) and every board build a scene's
 //! controller, so they run the same variant; [`Station::selection`] says which and why, for the
 //! line printed at scene start.
+//!
+//! The board gives the station its two load-cell channels ([`SensorChannel`]: its converter's
+//! format, fault checks and calibration): the station reads the board's own codes.
 //!
 //! A board feeds it the converter codes of each period ([`Station::control`]) and applies the
 //! returned drive amplitude; between two periods it hands it the commands that change the loop
 //! ([`Station::execute`]): a command is applied whole or refused with the protocol error, never
-//! half-applied. The scene closed loop of [`crate::sim`] is this station plus a simulated plant
+//! half-applied. The scene closed loop of the simulation (`sonolube_sim`) is this station plus a simulated plant
 //! and a judge, so the host runs and the firmware runs share every line of the control path.
 //!
 //! `tare` and `cal` take a burst of samples from the cells through [`CellBench`]: a real board
@@ -21,17 +24,16 @@
 //! reads its simulated cells under the load the command names.
 
 use crate::control::{
-    Config, Controller, Inputs, Output, Sensor, SensorFault, SensorFaultKind, Settings,
+    Config, ConfigError, Controller, Inputs, Output, Sensor, SensorFault, SensorFaultKind, Settings,
 };
 use crate::fx::{Q8_24, Q16_16};
-use crate::plant::AnyModel;
+use crate::model::{AnyModel, ModelError};
 use core::fmt::Write;
 
 use crate::protocol::DRIVE_FREQ;
 use crate::protocol::{Axis, Command, ProtocolError, SupervisorState, TareAxes, TokenText};
 use crate::scene::Scene;
 use crate::sense::{SampleError, SensorChannel};
-use crate::sim::{COMMISSIONING_SAMPLES, SimError, controller_settings, sensor_channel};
 use crate::variant::{Selection, select};
 
 /// What a board gives the station each period.
@@ -54,6 +56,21 @@ pub struct Control {
     pub output: Output,
     /// The fault the sensing chain found in this sample, if any.
     pub sensor_fault: Option<SensorFault>,
+}
+
+/// Samples averaged by `tare` and by `cal`: the mean of 256 samples has 1/16 of the noise
+/// (0.03 % of full scale for a 0.5 % cell), and the noise dithers the converter's steps so the
+/// mean resolves below one step.
+pub const COMMISSIONING_SAMPLES: usize = 256;
+
+/// Why a station cannot be built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum StationError {
+    /// The controller's model could not be built from the scene's controller spec.
+    Model(ModelError),
+    /// The controller settings were refused.
+    Config(ConfigError),
 }
 
 /// Where `tare` and `cal` get their samples.
@@ -85,13 +102,19 @@ pub struct Station {
 
 impl Station {
     /// The station of `scene`: the controller model [`select`] chooses for it (built with
-    /// [`Selection::build`]), the controller with `settings`, the cells with their datasheet
-    /// calibration, the scene's drive frequency, idle, no target. Errors: the model, the
-    /// settings or a cell refused.
-    pub fn new(scene: &Scene<'_>, settings: &Settings) -> Result<Self, SimError> {
+    /// [`Selection::build`]), the controller with `settings` (normally
+    /// [`crate::control::controller_settings`]), the board's load-cell channels `normal` and
+    /// `tangential`, the scene's drive frequency, idle, no target. Errors: the model or the
+    /// settings refused.
+    pub fn new(
+        scene: &Scene<'_>,
+        settings: &Settings,
+        normal: SensorChannel,
+        tangential: SensorChannel,
+    ) -> Result<Self, StationError> {
         let selection = select(scene);
-        let model = selection.build(scene).map_err(SimError::Model)?;
-        Self::assemble(scene, settings, model, Some(selection))
+        let model = selection.build(scene).map_err(StationError::Model)?;
+        Self::assemble(scene, settings, model, Some(selection), normal, tangential)
     }
 
     /// [`Station::new`] with the controller running `model` instead of the selected variant
@@ -100,8 +123,10 @@ impl Station {
         scene: &Scene<'_>,
         settings: &Settings,
         model: AnyModel,
-    ) -> Result<Self, SimError> {
-        Self::assemble(scene, settings, model, None)
+        normal: SensorChannel,
+        tangential: SensorChannel,
+    ) -> Result<Self, StationError> {
+        Self::assemble(scene, settings, model, None, normal, tangential)
     }
 
     fn assemble(
@@ -109,23 +134,20 @@ impl Station {
         settings: &Settings,
         model: AnyModel,
         selection: Option<Selection>,
-    ) -> Result<Self, SimError> {
-        let controller = Controller::new(Config::new(settings).map_err(SimError::Config)?);
+        normal: SensorChannel,
+        tangential: SensorChannel,
+    ) -> Result<Self, StationError> {
+        let controller = Controller::new(Config::new(settings).map_err(StationError::Config)?);
         Ok(Self {
             model,
             selection,
             controller,
-            normal: sensor_channel(&scene.normal_cell)?,
-            tangential: sensor_channel(&scene.tangential_cell)?,
+            normal,
+            tangential,
             drive_hz: scene.transducer.drive_hz as f32,
             // Scene drive frequencies are validated to 20-60 kHz: the cast cannot wrap.
             drive_freq_chz: libm::round(scene.transducer.drive_hz * 100.0) as u32,
         })
-    }
-
-    /// [`Station::new`] with the scene's controller settings ([`controller_settings`]).
-    pub fn for_scene(scene: &Scene<'_>) -> Result<Self, SimError> {
-        Self::new(scene, &controller_settings(scene))
     }
 
     /// One control period: the codes through the sensing chain (format, fault checks,
@@ -328,166 +350,4 @@ fn sense(channel: &mut SensorChannel, code: u16, sensor: Sensor) -> (Q16_16, Opt
         Err(SampleError::Code(_)) => SensorFaultKind::OutOfRange,
     };
     (Q16_16::ZERO, Some(SensorFault { sensor, kind }))
-}
-
-#[cfg(test)]
-mod tests {
-    use crate::protocol::{Axis, Command, ErrorCode, SupervisorState, TareAxes, Target};
-    use crate::scene::find;
-    use crate::sim::{ClosedLoop, Mode};
-
-    fn operated() -> ClosedLoop<'static> {
-        ClosedLoop::operated(find("reference").expect("built in")).expect("runs")
-    }
-
-    fn code(result: Result<(), crate::protocol::ProtocolError>) -> Option<ErrorCode> {
-        result.err().map(|e| e.code())
-    }
-
-    #[test]
-    fn an_operated_loop_holds_the_commanded_coefficient_and_stops_on_command() {
-        let mut run = operated();
-        assert_eq!(run.mode(), Mode::Operated);
-        // Idle, no target: the drive stays off.
-        for _ in 0..20 {
-            let record = run.step().expect("never finishes");
-            assert_eq!(record.drive_amplitude, 0.0);
-        }
-        assert_eq!(
-            code(run.execute(&Command::Start)),
-            Some(ErrorCode::NoTarget)
-        );
-        let target = Target::Coef { coef_ppm: 150_000 };
-        assert_eq!(run.execute(&Command::Target(target)), Ok(()));
-        assert_eq!(run.execute(&Command::Start), Ok(()));
-        let mut last = None;
-        for _ in 0..200 {
-            last = run.step();
-        }
-        let record = last.expect("never finishes");
-        assert_eq!(record.state, SupervisorState::Running);
-        let mu = record.estimated_friction_n / record.normal_load_n;
-        assert!((mu - 0.15).abs() < 0.15 * 0.03, "mu {mu}");
-        assert_eq!(run.execute(&Command::Stop), Ok(()));
-        for _ in 0..200 {
-            last = run.step();
-        }
-        let record = last.expect("never finishes");
-        assert_eq!(record.drive_amplitude, 0.0);
-        assert_eq!(record.state, SupervisorState::Idle);
-    }
-
-    #[test]
-    fn a_scripted_loop_refuses_the_operators_commands_and_keeps_its_state() {
-        let mut run = ClosedLoop::new(find("reference").expect("built in")).expect("runs");
-        run.step().expect("first step");
-        let before = run.controller().target();
-        let refused = run.execute(&Command::Target(Target::Coef { coef_ppm: 100_000 }));
-        assert_eq!(code(refused), Some(ErrorCode::WrongState));
-        assert_eq!(
-            code(run.execute(&Command::Stop)),
-            Some(ErrorCode::WrongState)
-        );
-        assert_eq!(run.controller().target(), before);
-    }
-
-    #[test]
-    fn tare_and_cal_need_the_drive_off_and_change_nothing_when_refused() {
-        let mut run = operated();
-        assert_eq!(run.execute(&Command::Tare(TareAxes::All)), Ok(()));
-        let cal = Command::Cal {
-            axis: Axis::Normal,
-            load_mn: 5_000,
-        };
-        assert_eq!(run.execute(&cal), Ok(()));
-        run.execute(&Command::Target(Target::Reduction {
-            reduction_mpct: 30_000,
-        }))
-        .expect("target");
-        run.execute(&Command::Start).expect("start");
-        for _ in 0..50 {
-            run.step();
-        }
-        let state = run.controller().state();
-        assert_ne!(state, SupervisorState::Idle);
-        assert_eq!(
-            code(run.execute(&Command::Tare(TareAxes::One(Axis::Tangential)))),
-            Some(ErrorCode::WrongState)
-        );
-        assert_eq!(code(run.execute(&cal)), Some(ErrorCode::WrongState));
-    }
-
-    /// The current a ceiling lets through at the configured drive frequency, A.
-    fn current_at_ceiling(run: &ClosedLoop<'_>) -> (f64, crate::control::Binding) {
-        let config = run.station().controller().config();
-        let r = config.actuator();
-        let a = config.limit().max_amplitude.to_f64();
-        let current = core::f64::consts::TAU
-            * r.drive_frequency_hz
-            * r.capacitance_f
-            * a
-            * r.full_scale_voltage_v;
-        (current, config.limit().binding)
-    }
-
-    #[test]
-    fn the_amplitude_ceiling_follows_the_drive_frequency() {
-        use crate::control::Binding;
-        // The welding converter of horn-al-ss: 1 kV at full scale into 20 nF, 6 A rating.
-        let mut run = ClosedLoop::operated(find("horn-al-ss").expect("built in")).expect("runs");
-        let rating = run.station().controller().config().actuator().max_current_a;
-        let (current, binding) = current_at_ceiling(&run);
-        assert_ne!(
-            binding,
-            Binding::Current,
-            "{current} A at the scene's 20.03 kHz"
-        );
-        assert!(current < rating);
-        // At 60 kHz, 2 pi f C V_fs = 7.5 A at full scale: the 6 A rating binds.
-        assert_eq!(
-            run.execute(&Command::Freq {
-                freq_chz: 6_000_000
-            }),
-            Ok(())
-        );
-        let (current, binding) = current_at_ceiling(&run);
-        assert_eq!(binding, Binding::Current);
-        assert!(
-            current <= rating && current > rating * (1.0 - 1e-6),
-            "{current} A"
-        );
-        // Back down: the ceiling rises again.
-        assert_eq!(
-            run.execute(&Command::Freq {
-                freq_chz: 2_003_000
-            }),
-            Ok(())
-        );
-        let (_, binding) = current_at_ceiling(&run);
-        assert_ne!(binding, Binding::Current);
-    }
-
-    #[test]
-    fn a_drive_frequency_outside_the_range_is_refused_and_kept() {
-        let mut run = operated();
-        let before = run.station().drive_hz();
-        let refused = run.execute(&Command::Freq {
-            freq_chz: 6_000_001,
-        });
-        assert_eq!(code(refused), Some(ErrorCode::OutOfRange));
-        assert_eq!(run.station().drive_hz(), before);
-        assert_eq!(
-            run.execute(&Command::Freq {
-                freq_chz: 3_950_050
-            }),
-            Ok(())
-        );
-        assert_eq!(run.station().drive_hz(), 39_500.5);
-        assert_eq!(run.station().drive_freq_chz(), 3_950_050);
-        // Not the loop's commands.
-        assert_eq!(
-            code(run.execute(&Command::Version)),
-            Some(ErrorCode::WrongState)
-        );
-    }
 }

@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 use scene_toml as toml_scene;
 use scene_toml::{SceneDescription, SceneError};
 use sonolube::fx::{Q1_31, Q8_24, Q16_16};
+use sonolube::model::AnyModel;
 use sonolube::model::{FrictionModel, ModelError, OperatingPoint};
-use sonolube::plant::AnyModel;
 use sonolube::protocol::Target;
 use sonolube::scene::{
     Accuracy, Actuator, ActuatorKind, Breakpoint, Channel, Contents, Criterion, FaultEvent,

@@ -4,10 +4,10 @@
 
 use std::path::PathBuf;
 
-use sonolube::plant::Plant;
 use sonolube::protocol::{Target, is_scene_name};
 use sonolube::scene::{self, Criterion, ModelKind, SCENES, System, target_at};
 use sonolube_host::scene_file::{LoadedScene, out_of_reach, scenes_dir, target_ratio};
+use sonolube_sim::plant::Plant;
 
 fn loaded() -> Vec<LoadedScene> {
     LoadedScene::load_dir(&scenes_dir()).unwrap_or_else(|error| panic!("{error}"))

@@ -1,4 +1,4 @@
-//! Closed-loop scene runs (`sonolube::sim`, `sonolube scene`): the acceptance numbers on
+//! Closed-loop scene runs (`sonolube_sim`, `sonolube scene`): the acceptance numbers on
 //! the three acceptance scenes, measured here from the step records as well as by the judge;
 //! every shipped scene runs; runs and their files are the same every time; the command line's
 //! exit codes.
@@ -8,9 +8,9 @@ use std::process::Command;
 
 use sonolube::protocol::SupervisorState;
 use sonolube::scene::{SCENES, Scene, find};
-use sonolube::sim::{ClosedLoop, Measured, RunSummary, StepRecord};
 use sonolube::variant::{Reason, select};
 use sonolube_host::cli::scene::{model_line, model_name, run_one};
+use sonolube_sim::{ClosedLoop, Measured, RunSummary, StepRecord};
 
 fn run(scene: &Scene<'_>) -> (Vec<StepRecord>, RunSummary) {
     let mut sim = ClosedLoop::new(scene).unwrap_or_else(|e| panic!("{}: {e:?}", scene.name));

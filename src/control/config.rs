@@ -16,7 +16,8 @@ use super::sliding::SlidingConfig;
 use super::supervisor::RampConfig;
 use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
 
-/// Controller settings, SI units. [`Settings::REFERENCE`] is the acceptance scene's tuning.
+/// Controller settings, SI units. Scenes and boards run [`super::controller_settings`] (the
+/// tuning, `control/tuning.rs`); [`Settings::REFERENCE`] is the baseline it starts from.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
     /// Control period, s (the loop runs at 1 / period; reference 100 us, 10 kHz).
@@ -77,9 +78,13 @@ pub struct Settings {
 }
 
 impl Settings {
-    /// The tuning for the reference scene (10 kHz loop, 40 kHz drive, 0.8 ms envelope lag);
-    /// the rationale is in the `control` module docs. `natural_prior` should be set to the
-    /// scene's coefficient.
+    /// The baseline at the reference scene's loop (10 kHz loop, 40 kHz drive, 0.8 ms envelope
+    /// lag), which the controller's unit tests run against the test plant (`closed_loop.rs`).
+    /// The tuning every scene and board runs is [`super::controller_settings`]: this baseline
+    /// with the scene's quantities and four departures, each with its reason at its constant in
+    /// `control/tuning.rs` (both force filters [`super::FORCE_FILTER_HZ`], prior weight
+    /// [`super::NATURAL_PRIOR_WEIGHT`], debounce [`super::SLIDING_DEBOUNCE_S`], steady gains
+    /// [`super::STEADY_GAINS`]).
     pub const REFERENCE: Self = Self {
         period_s: 1e-4,
         normal_bandwidth_hz: 200.0,

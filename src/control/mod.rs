@@ -37,15 +37,19 @@
 //!
 //! # Estimate (estimate.rs, sliding.rs)
 //!
-//! First-order low-passes (filter.rs, exactly -3 dB at the stated frequency):
-//! **tangential force 800 Hz** (`tau` 0.2 ms: the friction must be seen within a fraction of
-//! the 3 ms settling budget), **normal force 200 Hz** and **velocity 200 Hz** (slow signals whose
-//! noise enters the ratio one for one; the lag error of the normal force on the acceptance load
-//! ramp is `(tau_n - tau_t) dF_n/dt / F_n` = 0.6 ms × 5 /s = 0.3 %). `mu = |F_t| / F_n`, with
+//! First-order low-passes (filter.rs, exactly -3 dB at the stated frequency): **both forces
+//! 250 Hz** ([`FORCE_FILTER_HZ`]: equal filters make `F_t / F_n` follow a load change exactly;
+//! the prediction passes the same filter) and **velocity 200 Hz**. `mu = |F_t| / F_n`, with
 //! `F_n` guarded at `F_n_min` (0.5 N): below it the contact counts as unloaded. `mu0` starts at
-//! the scene's `mu` and is learned (running mean, then a 0.2 s window) only while sliding with
-//! the drive off, e.g. before a start or while the target is natural friction. Sliding:
-//! hysteresis 1 / 0.5 mm/s and a 2 ms debounce.
+//! the scene's `mu`, worth one sample ([`NATURAL_PRIOR_WEIGHT`]), and is learned (running
+//! mean, then a 0.2 s window) only while sliding with the drive off, e.g. before a start or
+//! while the target is natural friction. Sliding: hysteresis 1 / 0.5 mm/s and a 1 ms debounce
+//! ([`SLIDING_DEBOUNCE_S`]).
+//!
+//! The tuning every scene and board runs is [`controller_settings`] (why each value:
+//! `tuning.rs`). It starts from [`Settings::REFERENCE`], a baseline with a 200 Hz normal and an
+//! 800 Hz tangential filter, prior weight 4, a 2 ms debounce and steady gains kp 0 / ki 150 /s;
+//! the controller's unit tests against the test plant (and "Numbers" below) run that baseline.
 //!
 //! # Feedforward, reference and PI (pi.rs, schedule.rs)
 //!
@@ -69,11 +73,12 @@
 //! Tuning by pole placement. For a static mismatch `d`, `e_k = -(d + c_(k-1))`, so the
 //! correction obeys `c_k = (1 - kp - kiT) c_(k-1) + kp c_(k-2)` + drive: poles
 //! `z^2 - (1 - kp - kiT) z - kp = 0`. **Fast gains `kp` 0.3, `ki` 4000 /s** (`kiT` 0.4): poles
-//! 0.72 and -0.42, a 0.3 ms time constant, the scale of the two lags the mismatch is seen
-//! through (response 0.25 ms, filter 0.2 ms); faster overcorrects, because the mismatch seen
-//! mid-transient belongs to another amplitude (with ±20 % mismatch `d` itself changes with `c`
-//! by a factor 0.8 to 1.25, the margin this leaves). **Slow gains `kp` 0, `ki` 150 /s**: pole
-//! 0.985, 6.7 ms, a noise bandwidth of about 24 Hz. The gains start fast when the loop closes or
+//! 0.72 and -0.42, a 0.3 ms time constant, the scale of the response the mismatch is seen
+//! through (0.25 ms; the force filters' lag is in the prediction too); faster overcorrects,
+//! because the mismatch seen mid-transient belongs to another amplitude (with ±20 % mismatch
+//! `d` itself changes with `c` by a factor 0.8 to 1.25, the margin this leaves). **Slow gains `kp` 0.1, `ki` 300 /s**
+//! ([`STEADY_GAINS`]): poles 0.973 and -0.103, 3.6 ms, fast enough to follow a model error that
+//! moves with the operating point. The gains start fast when the loop closes or
 //! the target changes and fade to the slow set with **`tau_boost` = 3 ms** (the settling budget):
 //! the model error of a new operating point is found quickly, then averaged.
 //!
@@ -93,7 +98,8 @@
 //! or load ramps down to zero and restarts when the contact returns. Commands return
 //! [`ControlError`], which maps to the protocol's codes 21-23 (and 6 for a bad target).
 //!
-//! # Numbers (the test plant, `cargo test -p sonolube --lib control::closed_loop -- --nocapture`)
+//! # Numbers (the test plant with the [`Settings::REFERENCE`] baseline,
+//! `cargo test -p sonolube --lib control::closed_loop -- --nocapture`)
 //!
 //! Littmann plant and model, 40 N, 0.038 m/s, 0.8 ms envelope lag, 10 kHz; plant amplitude
 //! scale and scene `mu` each off by ±20 % (all four corners); target step 100 % → 50 % of
@@ -128,6 +134,7 @@ mod shaper;
 mod sliding;
 mod supervisor;
 mod target;
+mod tuning;
 
 #[cfg(test)]
 mod closed_loop;
@@ -156,3 +163,6 @@ pub use shaper::{DriveShaper, Shaped, ShaperConfig, ShaperError};
 pub use sliding::{SlidingConfig, SlidingDetector};
 pub use supervisor::{Contact, RampConfig, Supervisor};
 pub use target::{ForceQ, PreparedTarget};
+pub use tuning::{
+    FORCE_FILTER_HZ, NATURAL_PRIOR_WEIGHT, SLIDING_DEBOUNCE_S, STEADY_GAINS, controller_settings,
+};

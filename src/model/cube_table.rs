@@ -15,9 +15,9 @@
 //!
 //! Node values are Q2.30 `i32` (F'/F in (0, 1] at the node, the only configuration tabulated:
 //! see below), row-major, in a fixed-capacity array of [`MAX_NODES`] (17 x 17, 1,156 bytes)
-//! whatever the knob: `crate::plant::AnyModel` holds one model by value (no heap), so its size
+//! whatever the knob: `crate::model::AnyModel` holds one model by value (no heap), so its size
 //! is that of its largest variant anyway. 33 x 33 (4,356 bytes) was tried and dropped: it made
-//! every `AnyModel` (the plant's and the controller's) 5.4 KB and a `sim::ClosedLoop` 18 KB,
+//! every `AnyModel` (the plant's and the controller's) 5.4 KB and a `sonolube_sim::ClosedLoop` 18 KB,
 //! and the QEMU benchmark build, which builds closed loops on its stack, ended in a watchdog
 //! reset; its error (1.1e-4 against the exact model on 40-240 N) is not needed by any scene's
 //! budget, and 17 x 17 already gives 4.2e-4.

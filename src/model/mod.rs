@@ -13,6 +13,7 @@
 use core::fmt;
 
 pub mod actuator;
+pub mod any_model;
 pub mod contact;
 pub mod contact_constants;
 pub mod coulomb;
@@ -28,12 +29,15 @@ pub mod dahl_relax;
 pub mod dahl_steady;
 pub(crate) mod dahl_travel;
 pub mod dahl_window;
+pub mod exp_average;
 pub mod exp_coulomb;
 pub mod horn;
 pub mod littmann;
 pub mod quadrature;
 pub mod scaled;
 pub mod wide;
+
+pub use any_model::AnyModel;
 
 use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
 

@@ -1,7 +1,7 @@
 //! The motional current: the measured current minus the clamped capacitance's, and the
 //! detuning it reveals.
 //!
-//! Butterworth-Van Dyke model (physics-notes §6; `crate::plant`): the stack's admittance is
+//! Butterworth-Van Dyke model (physics-notes §6; `sonolube_sim::plant`): the stack's admittance is
 //! `j w C0` in parallel with the motional branch `1 / (R1 + j X)`, `X = w L1 - 1 / (w C1)`. The
 //! series (motional) resonance, where the vibration peaks, is `X = 0`: the motional current is
 //! in phase with the voltage and the conductance `Re Y` peaks. The *total* current is not in

@@ -16,7 +16,7 @@
 //! follows the frequency: 100 us at 40 kHz for 4 periods). The envelope time constant `tau = 2Q / (2 pi f0)` (0.8 ms at 40 kHz,
 //! Q 100) makes a fully settled sweep slow (3 tau per point, 50 ms for +-10 % at one
 //! bandwidth per point), so the coarse sweep dwells less and its peak comes late, by 60-180 Hz
-//! on `crate::plant` (whose motional phase follows the frequency at once) and 360-570 Hz on a
+//! on `sonolube_sim::plant` (whose motional phase follows the frequency at once) and 360-570 Hz on a
 //! complex envelope (a real series branch) at one bandwidth per 0.2 ms (tests). The sweep therefore runs on
 //! past the band for one `tau` (the overrun) so that a resonance at the band's top still shows
 //! a peak, and leaves the last word to the phase loop (`search`), which needs only a bracket.

@@ -1,5 +1,5 @@
 //! Test fixture: a Butterworth-Van Dyke resonator in f64 whose motional current either follows
-//! the drive frequency at once (as `crate::plant` does) or lags by the envelope time constant
+//! the drive frequency at once (as `sonolube_sim::plant` does) or lags by the envelope time constant
 //! (the complex envelope of a real series RLC branch), to check the loops on both.
 
 use std::f64::consts::TAU;
@@ -12,7 +12,7 @@ use crate::fx::Q2_30;
 /// How the motional current responds to a change of drive frequency.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Dynamics {
-    /// Amplitude through a first-order envelope, phase at once (`crate::plant`'s model).
+    /// Amplitude through a first-order envelope, phase at once (`sonolube_sim::plant`'s model).
     InstantPhase,
     /// Complex envelope of the series branch: `2 L1 da/dt = V - Z(f) a`.
     Lagged,

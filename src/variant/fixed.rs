@@ -1,5 +1,5 @@
 //! Building a variant's model for a scene: what the controller would run (fixed point, as
-//! [`crate::plant::AnyModel`]) and the parameters the float forms share with it.
+//! [`crate::model::AnyModel`]) and the parameters the float forms share with it.
 //!
 //! Every form takes the scene's *controller* parameters (its belief about mu, k_t and the
 //! surface: the mismatch with the plant is the feedback's business, not the model's) and the
@@ -11,7 +11,9 @@
 
 use super::float_cube::FloatCubeParams;
 use super::{Fidelity, Variant};
+use crate::model::AnyModel;
 use crate::model::ModelError;
+use crate::model::any_model::contact_params;
 use crate::model::contact::{ContactKind, EStarRule};
 use crate::model::coulomb::{CoulombConstants, CoulombModel};
 use crate::model::cube::{CubeOptions, CubeParams};
@@ -21,8 +23,6 @@ use crate::model::dahl::DahlParams;
 use crate::model::dahl_steady::DahlModel;
 use crate::model::horn::UPhase;
 use crate::model::quadrature::SlipWindow;
-use crate::plant::AnyModel;
-use crate::plant::any_model::contact_params;
 use crate::scene::Scene;
 
 /// What a scene's controller spec lacks for a fidelity level.

@@ -274,7 +274,7 @@ impl Variant {
 
 /// Names of the control-step measurements of the QEMU benchmark build, one per fidelity level
 /// the controller can run, with the scene each is timed on, the fidelity, and the table side
-/// (nodes per axis; 0: the fidelity's model at the knob `crate::plant::AnyModel::new` uses,
+/// (nodes per axis; 0: the fidelity's model at the knob `crate::model::AnyModel::new` uses,
 /// Dahl N = 64, cube N = 16; otherwise the table variant of that side, [`lookup_table`]). The
 /// first is the default fidelity (the `reference` scene's Coulomb controller).
 pub const CONTROL_STEPS: &[(&str, &str, Fidelity, u8)] = &[

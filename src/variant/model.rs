@@ -12,8 +12,8 @@ use super::float_inplane::{FloatCoulomb, FloatDahl, dahl_update, littmann};
 use super::grid::{DahlUpdateInput, GridPoint};
 use super::real::{Libm, Maths, Micromath, Real};
 use super::{Fidelity, Form, Variant};
+use crate::model::AnyModel;
 use crate::model::{FrictionModel, ModelError, dahl, littmann};
-use crate::plant::AnyModel;
 use crate::scene::Scene;
 
 /// A friction-model level in one float type.

@@ -35,8 +35,8 @@ use core::fmt;
 
 use super::fixed::{buildable, fixed_model};
 use super::{CATALOGUE, Family, Fidelity, Form, Variant, table};
+use crate::model::AnyModel;
 use crate::model::ModelError;
-use crate::plant::AnyModel;
 use crate::scene::{ModelKind, ModelSpec, Scene};
 
 /// Instructions per evaluation below which two measured costs are not told apart: the QEMU

@@ -1,5 +1,4 @@
-//! The load-cell codes on their way from the sensing task to the control loop, and their
-//! conversion to the scene cell's converter format.
+//! The load-cell codes on their way from the sensing task to the control loop.
 //!
 //! The sensing task ([`crate::sense_task`]) gets one ADC1 triplet per DMA half-buffer and
 //! [`publish`]es its two load-cell codes into a short queue. The control loop drains the queue
@@ -15,24 +14,17 @@
 //! stuck-reading check is widened by that factor ([`crate::rig`]), otherwise a held sample would
 //! read as a stuck cell.
 //!
-//! # Format conversion (an assumption, see [`CodeMap`])
-//!
-//! The station reads codes in the format of the *scene's* cells (`sonolube::sim::cell_format`:
-//! unipolar, `adc_bits` bits, zero force at mid-scale, `full_scale_n` at either end). The board
-//! has other cells: 16-bit oversampled ADC1 codes through the INA826 front end of
-//! [`config::LOAD_CELL_INTERNAL`] (222 N cells, about 488 N per converter span). [`CodeMap`]
-//! converts a real code to newtons with the board's datasheet calibration and expresses that
-//! force as the scene cell's code, so the station's own calibration (its nominal one, then
-//! `tare` and `cal`) applies unchanged.
+//! The codes stay in the board's format ([`config::ADC_FORMAT`]: 16-bit oversampled ADC1 codes
+//! through the INA826 front end of [`config::LOAD_CELL_INTERNAL`]): the station reads them
+//! through channels of that format and that calibration ([`crate::rig`]).
 
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use sonolube::protocol::Axis;
-use sonolube::scene::LoadCell;
-use sonolube::sense::{AdcFormat, Calibration, FaultLimits};
-use sonolube::sim::COMMISSIONING_SAMPLES;
+use sonolube::sense::{AdcFormat, FaultLimits};
+use sonolube::station::COMMISSIONING_SAMPLES;
 
 use crate::config;
 
@@ -92,94 +84,11 @@ pub async fn first() -> RawPair {
     CODES.receive().await
 }
 
-/// A real ADC1 code of one cell to the code the scene's cell would give for the same force.
-///
-/// Assumptions, all of them the board's documented front end (board README, "Power stage and
-/// front ends"): the cell and amplifier follow their datasheet calibration
-/// ([`config::LOAD_CELL_INTERNAL`]: zero force at mid-scale, the rated load at 1.5 V from
-/// it); the offset and gain errors of the real cell stay in the codes, where the station's
-/// `tare` and `cal` remove them as they would on the scene's cell. The conversion is linear and
-/// exact up to rounding to the scene's converter step; it cannot add resolution: with the
-/// board's 222 N cells one real step is 7.45 mN, 7.6 steps of the `reference` scene's 2 N
-/// tangential cell.
-///
-/// Forces beyond the scene cell's full scale give its end codes, which the station reads as a
-/// rail (a `disconnected` sensor fault, drive safe): the scene's cell would saturate the same
-/// way. A real code at the real converter's rail (within [`config::LOAD_CELL_LIMITS`]'s
-/// margin: an open bridge wire or a saturated amplifier) gives the scene cell's rail code
-/// whatever the scales, so a broken real cell always reads as one.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, defmt::Format)]
-pub struct CodeMap {
-    /// Scene codes per real code, Q32.32.
-    gain_q32: i64,
-    /// Scene code of real code 0, Q32.32.
-    offset_q32: i64,
-    /// The scene cell's largest code.
-    max_code: u16,
-    /// Real codes at or below this are the low rail.
-    low_rail: u16,
-    /// Real codes at or above this are the high rail.
-    high_rail: u16,
-}
-
-impl CodeMap {
-    /// The map from the board's cell with calibration `real` (newtons per converter span, zero
-    /// reading) to the scene's `cell`. Configuration, `f64`, once per scene.
-    pub fn new(cell: &LoadCell, real: &Calibration) -> Self {
-        let format = config::ADC_FORMAT;
-        // One real code as a fraction of the converter span (2^-16).
-        let per_code = format.normalize(1).map_or(0.0, |q| q.to_f64());
-        let zero_reading = real.offset().to_f64();
-        let newtons_per_span = real.span().to_f64();
-        let zero_code = f64::from(cell.zero_code());
-        let codes_per_newton = zero_code / cell.full_scale_n;
-        // scene = zero_code + (real * per_code - zero_reading) * span * codes_per_newton
-        let gain = per_code * newtons_per_span * codes_per_newton;
-        let offset = zero_code - zero_reading * newtons_per_span * codes_per_newton;
-        let (low_rail, high_rail) = rails(format, config::LOAD_CELL_LIMITS);
-        Self {
-            gain_q32: to_q32(gain),
-            offset_q32: to_q32(offset),
-            max_code: cell.max_code(),
-            low_rail,
-            high_rail,
-        }
-    }
-
-    /// Whether `real` is at the real converter's rail (or is a code it cannot produce).
-    pub fn at_rail(&self, real: u16) -> bool {
-        real <= self.low_rail || real >= self.high_rail
-    }
-
-    /// The scene cell's code for the real code `real`. Integer: one 64-bit product.
-    pub fn convert(&self, real: u16) -> u16 {
-        if real <= self.low_rail {
-            return 0;
-        }
-        if real >= self.high_rail {
-            return self.max_code;
-        }
-        let scaled = self
-            .gain_q32
-            .saturating_mul(i64::from(real))
-            .saturating_add(self.offset_q32)
-            .saturating_add(1 << 31)
-            >> 32;
-        u16::try_from(scaled.clamp(0, i64::from(self.max_code))).unwrap_or(self.max_code)
-    }
-}
-
-/// `value` in Q32.32, saturated to +-2^30 (a scene cell millions of times finer than the board's
-/// converter: meaningless, but not a panic).
-fn to_q32(value: f64) -> i64 {
-    const LIMIT: f64 = (1u64 << 30) as f64;
-    let clamped = if value.is_nan() {
-        0.0
-    } else {
-        value.clamp(-LIMIT, LIMIT)
-    };
-    // |clamped| * 2^32 <= 2^62: within i64; `as` rounds toward zero, enough here.
-    (clamped * 4_294_967_296.0) as i64
+/// Whether `real` is at the converter's rail (within [`config::LOAD_CELL_LIMITS`]'s margin: an
+/// open bridge wire or a saturated amplifier), or is a code it cannot produce.
+fn at_rail(real: u16) -> bool {
+    let (low_rail, high_rail) = rails(config::ADC_FORMAT, config::LOAD_CELL_LIMITS);
+    real <= low_rail || real >= high_rail
 }
 
 /// The real codes at which `limits` call the reading a rail: the last code within the margin
@@ -265,13 +174,12 @@ impl CellFeed {
         };
     }
 
-    /// Fills `codes` with the newest `codes.len()` codes of `axis`, oldest first, converted
-    /// with `map`: the samples of the moments before the command, under the load the operator
-    /// put on the cell. False (nothing usable) when fewer have been recorded, when the bridge
+    /// Fills `codes` with the newest `codes.len()` codes of `axis`, oldest first: the samples
+    /// of the moments before the command, under the load the operator put on the cell. False (nothing usable) when fewer have been recorded, when the bridge
     /// switched during any of them (a vibrating contact loads the cells), when `fresh` is false
     /// (sensing has stopped, the history is old) or when one of them is at the real
     /// converter's rail.
-    pub fn burst(&self, axis: Axis, map: &CodeMap, fresh: bool, codes: &mut [i32]) -> bool {
+    pub fn burst(&self, axis: Axis, fresh: bool, codes: &mut [i32]) -> bool {
         let wanted = codes.len();
         let Ok(wanted_u32) = u32::try_from(wanted) else {
             return false;
@@ -296,11 +204,11 @@ impl CellFeed {
                 .copied()
                 .unwrap_or(RawPair::ZERO);
             let real = pair.code(axis);
-            if map.at_rail(real) {
+            if at_rail(real) {
                 defmt::warn!("cells: {} cell at its rail during the burst", axis);
                 return false;
             }
-            *slot = i32::from(map.convert(real));
+            *slot = i32::from(real);
         }
         true
     }

@@ -1,10 +1,14 @@
 //! The board's control loop: the firmware's station on the real load cells and the real
 //! half-bridge.
 //!
-//! Each period the newest load-cell pair from the sensing task ([`crate::cells`]) goes, in the
-//! scene cell's format, through the station (sensing chain, controller, model) of the selected
-//! scene, and the controller's output goes to the bridge ([`crate::bridge`]). This is the
-//! QEMU board's rig with hardware where the simulated plant was.
+//! Each period the newest load-cell pair from the sensing task ([`crate::cells`]) goes through
+//! the station (sensing chain, controller, model) of the selected scene, and the controller's
+//! output goes to the bridge ([`crate::bridge`]). The station's channels are the board's own
+//! ([`cell_channel`]: the internal ADC's format, the board's fault limits, the cells' datasheet
+//! calibration, then `tare` and `cal`); the controller runs the core's tuning for the scene
+//! ([`sonolube::control::controller_settings`]), whose plausible force ranges are the scene
+//! cells' (1.1 x their full scale): a force beyond it is a sensor fault, drive safe. This is
+//! the QEMU board's rig with hardware where the simulated plant was.
 //!
 //! # What the board cannot measure
 //!
@@ -16,24 +20,23 @@
 //! - **Fresh samples every period**: the cells are converted at 833 pairs/s (40 kHz drive), so
 //!   each pair is held for several periods; the station's stuck-reading check is widened by the
 //!   longest hold in the drive band ([`hold_steps`]). A pair older than [`STALE_HOLDS`] holds
-//!   (sensing has stopped) is given to the station as the cells' low-rail code, which it reads
-//!   as a disconnected normal-force sensor: a sensor fault, drive safe.
+//!   (sensing has stopped) is given to the station as code 0, the converter's low rail, which
+//!   it reads as a disconnected normal-force sensor: a sensor fault, drive safe.
 
 use core::fmt::Write as _;
 
 use cortex_m::peripheral::DWT;
-use sonolube::control::{ExternalFault, Reason};
+use sonolube::control::{ExternalFault, Reason, controller_settings};
 use sonolube::drive::Frequency;
 use sonolube::protocol::{Axis, Command, DRIVE_FREQ, ProtocolError, SupervisorState, TokenText};
-use sonolube::scene::{LoadCell, Scene};
-use sonolube::sense::{SenseError, SensorChannel};
-use sonolube::sim::{SimError, fault_limits};
-use sonolube::station::{CellBench, Sample, Station};
+use sonolube::scene::Scene;
+use sonolube::sense::{Calibration, SenseError, SensorChannel};
+use sonolube::station::{CellBench, Sample, Station, StationError};
 use sonolube_app::control::ControlLoop;
 use sonolube_app::snapshot::Snapshot;
 
 use crate::bridge::{Bridge, CONTROLS_BRIDGE, DriveRefusal};
-use crate::cells::{CellFeed, CodeMap, RawPair};
+use crate::cells::{CellFeed, RawPair};
 use crate::sensing::TRIGGERS_PER_TRIPLET;
 use crate::{config, drive};
 
@@ -44,7 +47,7 @@ pub const STALE_HOLDS: u32 = 8;
 #[derive(Debug, Clone, Copy, PartialEq, defmt::Format)]
 pub enum SceneRefusal {
     /// The station (model, controller, cells) cannot be built from the scene.
-    Station(SimError),
+    Station(StationError),
     /// The bridge cannot run the scene's drive.
     Drive(DriveRefusal),
     /// The board's load-cell calibration ([`config::LOAD_CELL_INTERNAL`]) is unusable.
@@ -55,7 +58,6 @@ pub enum SceneRefusal {
 struct Setup {
     scene: &'static Scene<'static>,
     station: Station,
-    maps: [CodeMap; 2],
     bridge: Bridge,
     sliding_velocity_m_per_s: f32,
     stale_after_steps: u32,
@@ -66,7 +68,7 @@ impl Setup {
     /// model's tables), between two steps; its duration on silicon is unmeasured (an overrun is
     /// counted if it exceeds a period).
     fn new(scene: &'static Scene<'static>) -> Result<Self, SceneRefusal> {
-        let real = config::LOAD_CELL_INTERNAL
+        let calibration = config::LOAD_CELL_INTERNAL
             .calibration()
             .map_err(SceneRefusal::Cells)?;
         // The cheap check first: a scene the bridge cannot drive builds no model.
@@ -75,11 +77,10 @@ impl Setup {
             scene.actuator.full_scale_voltage_v,
         )
         .map_err(SceneRefusal::Drive)?;
-        let mut station = Station::for_scene(scene).map_err(SceneRefusal::Station)?;
         let hold = hold_steps(scene.control_rate_hz);
-        let (normal, tangential) = station.channels_mut();
-        widen_stuck_check(normal, &scene.normal_cell, hold);
-        widen_stuck_check(tangential, &scene.tangential_cell, hold);
+        let channel = cell_channel(calibration, hold);
+        let station = Station::new(scene, &controller_settings(scene), channel, channel)
+            .map_err(SceneRefusal::Station)?;
         let sliding_velocity_m_per_s = scene
             .sliding_velocity_m_per_s
             .first()
@@ -87,10 +88,6 @@ impl Setup {
         Ok(Self {
             scene,
             station,
-            maps: [
-                CodeMap::new(&scene.normal_cell, &real),
-                CodeMap::new(&scene.tangential_cell, &real),
-            ],
             bridge,
             sliding_velocity_m_per_s,
             stale_after_steps: hold.saturating_mul(STALE_HOLDS),
@@ -111,12 +108,14 @@ pub fn hold_steps(control_rate_hz: f64) -> u32 {
     u32::try_from(hold).unwrap_or(u32::MAX)
 }
 
-/// The station's channel with its stuck check counting `hold` times as many periods: a held
-/// pair repeats its code for `hold` periods, which is no sign of a stuck cell.
-fn widen_stuck_check(channel: &mut SensorChannel, cell: &LoadCell, hold: u32) {
-    let mut limits = fault_limits(cell);
+/// A load cell's channel for the station: the internal ADC's format ([`config::ADC_FORMAT`]),
+/// the board's fault limits ([`config::LOAD_CELL_LIMITS`]) with the stuck check counting `hold`
+/// times as many periods (a held pair repeats its code for `hold` periods, which is no sign of a
+/// stuck cell), and `calibration` (the cells' datasheet calibration until `tare` and `cal`).
+pub fn cell_channel(calibration: Calibration, hold: u32) -> SensorChannel {
+    let mut limits = config::LOAD_CELL_LIMITS;
     limits.stuck_samples = limits.stuck_samples.saturating_mul(hold);
-    *channel = SensorChannel::new(channel.format(), limits, channel.calibration());
+    SensorChannel::new(config::ADC_FORMAT, limits, calibration)
 }
 
 /// The board's control loop on one scene.
@@ -219,7 +218,6 @@ impl BoardRig {
         };
         let mut bench = Bench {
             feed: &self.feed,
-            maps: &self.setup.maps,
             fresh: false,
         };
         self.setup.station.execute(command, &mut bench)?;
@@ -265,17 +263,12 @@ impl core::fmt::Write for Text {
 /// [`CellFeed::burst`]). `load_n` is ignored: the operator has put that load on the cell.
 struct Bench<'a> {
     feed: &'a CellFeed,
-    maps: &'a [CodeMap; 2],
     fresh: bool,
 }
 
 impl CellBench for Bench<'_> {
     fn burst(&mut self, axis: Axis, _load_n: f32, codes: &mut [i32]) -> bool {
-        let map = match axis {
-            Axis::Normal => &self.maps[0],
-            Axis::Tangential => &self.maps[1],
-        };
-        self.feed.burst(axis, map, self.fresh, codes)
+        self.feed.burst(axis, self.fresh, codes)
     }
 }
 
@@ -296,10 +289,7 @@ impl ControlLoop for BoardRig {
             // No pair for too long: the converter reads as disconnected (low rail).
             (0, 0)
         } else {
-            (
-                setup.maps[0].convert(pair.normal),
-                setup.maps[1].convert(pair.tangential),
-            )
+            (pair.normal, pair.tangential)
         };
         let control = setup.station.control(&Sample {
             normal_code,
@@ -352,7 +342,6 @@ impl ControlLoop for BoardRig {
                     command,
                     &mut Bench {
                         feed: &self.feed,
-                        maps: &self.setup.maps,
                         fresh,
                     },
                 );

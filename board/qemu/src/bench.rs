@@ -20,7 +20,7 @@
 //! intervals per chunk) is at most 0.3 instructions per call for the cheap calls (256 per
 //! chunk) and below 0.1 % of the expensive ones.
 //!
-//! The control step is `sonolube::sim::ClosedLoop::control_phase` (target, sensing, estimate,
+//! The control step is `sonolube_sim::ClosedLoop::control_phase` (target, sensing, estimate,
 //! model and its inverse, controller, drive command), timed around every step of a scene whose
 //! controller model is set to the fidelity level at its default knob
 //! (`ClosedLoop::with_model`, not the variant the scene selects); the plant's phase is not
@@ -36,11 +36,10 @@ use core::hint::black_box;
 use core::mem::MaybeUninit;
 
 use sonolube::fx::Q1_31;
+use sonolube::model::AnyModel;
 use sonolube::model::cube_table::CubeTable;
 use sonolube::model::{FrictionModel, OperatingPoint, dahl, littmann};
-use sonolube::plant::AnyModel;
 use sonolube::scene::{ModelKind, ModelSpec, SCENES, Scene};
-use sonolube::sim::{ClosedLoop, SimError};
 use sonolube::variant::fixed::fixed_model;
 use sonolube::variant::float_inplane::{dahl_update, littmann as float_littmann};
 use sonolube::variant::grid::{
@@ -52,6 +51,7 @@ use sonolube::variant::real::{Libm, Maths, Micromath, Real};
 use sonolube::variant::{
     CATALOGUE, CONTROL_STEPS, Family, Fidelity, Form, Model, Variant, lookup_table,
 };
+use sonolube_sim::{ClosedLoop, SimError};
 
 use crate::{time_driver, watchdog};
 

@@ -35,10 +35,10 @@ mod watchdog;
 use defmt_semihosting as _;
 use embassy_executor::{SendSpawner, raw};
 use embassy_time::{Duration, Instant};
-use sonolube::sim::Mode;
 use sonolube_app::console::Identity;
 use sonolube_app::control::Injection;
 use sonolube_app::{Board, console, control, heartbeat, supervisor};
+use sonolube_sim::Mode;
 use static_cell::StaticCell;
 
 use crate::args::Args;

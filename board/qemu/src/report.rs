@@ -8,8 +8,8 @@
 //! (125 M/s) 12,500; the G474 at 170 MHz does about 125-170 M instructions/s. The CPU load counts every cycle the CPU did not sleep in WFI (control, console,
 //! telemetry, executors), the simulated plant excluded ([`crate::time_driver::exclude`]).
 
-use sonolube::sim::{Measured, RunSummary};
 use sonolube_app::control::LoopStats;
+use sonolube_sim::{Measured, RunSummary};
 
 use crate::time_driver::CORE_CLOCK_HZ;
 

@@ -6,15 +6,15 @@
 //! run inside [`time_driver::exclude`]: they stand for hardware and for the test bench, so
 //! they take none of the firmware's time. Only the control part is timed for the snapshot.
 //!
-//! This is [`sonolube::sim::ClosedLoop`], the same code as `sonolube scene` on the host, with
+//! This is [`sonolube_sim::ClosedLoop`], the same code as `sonolube scene` on the host, with
 //! the plant reading the board's drive output instead of the controller's command directly.
 
 use sonolube::control::ExternalFault;
 use sonolube::protocol::{Command, ProtocolError, SceneName};
 use sonolube::scene::Scene;
-use sonolube::sim::{ClosedLoop, Mode, RunSummary, SimError};
 use sonolube_app::control::ControlLoop;
 use sonolube_app::snapshot::Snapshot;
+use sonolube_sim::{ClosedLoop, Mode, RunSummary, SimError};
 
 use crate::{drive, time_driver};
 

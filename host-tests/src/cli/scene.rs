@@ -1,4 +1,4 @@
-//! `sonolube scene`: runs a scene closed loop on the host ([`sonolube::sim::ClosedLoop`]),
+//! `sonolube scene`: runs a scene closed loop on the host ([`sonolube_sim::ClosedLoop`]),
 //! writes its time series as CSV and an SVG plot, and prints the model variant the controller
 //! runs and why (chosen by [`sonolube::variant::select`], as the firmware logs it at scene
 //! start), the metrics and the verdict of each of the scene's criteria. `--all` prints one line
@@ -49,7 +49,7 @@ use crate::scene_file::LoadedScene;
 use figure::svg;
 use report::{pass, report, short};
 use sonolube::scene::{SCENES, Scene};
-use sonolube::sim::{ClosedLoop, RunSummary};
+use sonolube_sim::{ClosedLoop, RunSummary};
 
 pub use csv::csv;
 pub use report::{model_line, model_name};

@@ -15,8 +15,8 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use sonolube::fx::{Q1_31, Q2_30};
+use sonolube::model::AnyModel;
 use sonolube::model::{FrictionModel, OperatingPoint, dahl, littmann};
-use sonolube::plant::AnyModel;
 use sonolube::scene::SCENES;
 use sonolube::variant::fixed::buildable;
 use sonolube::variant::float_inplane::{dahl_update, littmann as float_littmann};

@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 
 use sonolube::control::Reason;
 use sonolube::protocol::Target;
-use sonolube::sim::StepRecord;
+use sonolube_sim::StepRecord;
 
 /// The CSV text of a run: a header row, then one row per record (columns in the `scene`
 /// module docs).

@@ -4,7 +4,7 @@
 
 use sonolube::protocol::SupervisorState;
 use sonolube::scene::Scene;
-use sonolube::sim::{RunSummary, StepRecord};
+use sonolube_sim::{RunSummary, StepRecord};
 
 use super::report::{band_fraction, channel_name, fault_text, num, verdict};
 use crate::plot::{Band, Marker, Panel, Series, TimeSeriesPlot};

@@ -4,14 +4,14 @@ use std::fmt::Write as _;
 
 use sonolube::protocol::SupervisorState;
 use sonolube::scene::{Channel, Criterion, FaultKind, Scene};
-use sonolube::sim::{
-    DEFAULT_BAND, DEFAULT_STEADY_AFTER_S, Measured, Origin, RunSummary, StepRecord,
-};
 use sonolube::station::Station;
 use sonolube::variant::Selection;
+use sonolube_sim::{
+    DEFAULT_BAND, DEFAULT_STEADY_AFTER_S, Measured, Origin, RunSummary, StepRecord,
+};
 
 /// Where the segments' steady part starts, s after a change: the first `Settle` criterion's
-/// time, else the judge's default (as `sonolube::sim::Judge` does).
+/// time, else the judge's default (as `sonolube_sim::Judge` does).
 pub(super) fn steady_after_s(scene: &Scene<'_>) -> f32 {
     scene
         .criteria

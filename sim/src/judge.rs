@@ -18,8 +18,8 @@ use super::summary::{
     FaultReaction, Measured, Observation, Origin, RampTracking, RunSummary, StepSegment, Verdict,
 };
 use crate::metrics::{Metrics, MetricsConfig, SegmentMetrics};
-use crate::protocol::SupervisorState;
-use crate::scene::{Criterion, Scene};
+use sonolube::protocol::SupervisorState;
+use sonolube::scene::{Criterion, Scene};
 
 /// Largest number of stored step segments (the target table holds at most 64 points).
 pub const MAX_SEGMENTS: usize = 64;

@@ -2,7 +2,7 @@
 //! the cell) and `cal <axis> <newtons>` (a known load on it), done on simulated cells.
 //!
 //! A scene's cells read with an offset and a gain error that only the plant knows
-//! (`crate::scene::LoadCell`): the datasheet calibration leaves them in every reading, so a
+//! (`sonolube::scene::LoadCell`): the datasheet calibration leaves them in every reading, so a
 //! coefficient or force target would be held off by them (the `load-ramp` cells, 0.3 N and
 //! 0.5 % on the normal cell, -0.2 N and -0.5 % on the tangential one, make 2.5 % at 40 N).
 //! Commissioning removes them the way an operator does: a burst of samples with the cell
@@ -11,10 +11,10 @@
 //! with a noise generator of their own, so a run stays deterministic and its plant noise is
 //! untouched.
 
-use crate::fx::Q16_16;
 use crate::plant::{Gaussian, LoadCellSim};
-use crate::scene::LoadCell;
-use crate::sense::SensorChannel;
+use sonolube::fx::Q16_16;
+use sonolube::scene::LoadCell;
+use sonolube::sense::SensorChannel;
 
 use super::SimError;
 
@@ -36,10 +36,8 @@ pub const COMMISSIONED: CellCalibration = CellCalibration::Commissioned {
     known_load_of_full_scale: 0.5,
 };
 
-/// Samples averaged by the tare and by the known-load calibration: the mean of 256 samples
-/// has 1/16 of the noise (0.03 % of full scale for a 0.5 % cell), and the noise dithers the
-/// converter's steps so the mean resolves below one step.
-pub const COMMISSIONING_SAMPLES: usize = 256;
+/// Samples averaged by the tare and by the known-load calibration: the station's.
+pub use sonolube::station::COMMISSIONING_SAMPLES;
 
 /// Seed offset of the commissioning noise from the scene's plant noise seed.
 const SEED_OFFSET: u64 = 0xCA1B_0000_0000_0001;
@@ -91,8 +89,8 @@ pub fn commission(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::find;
-    use crate::sim::sensor_channel;
+    use crate::sensor_channel;
+    use sonolube::scene::find;
 
     /// Mean force over 2000 samples of a cell settled at `force_n` through `channel`.
     fn mean_reading(channel: &mut SensorChannel, cell: &LoadCell, force_n: f32) -> f64 {

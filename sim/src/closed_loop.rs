@@ -5,7 +5,7 @@
 //!    held and gives the converter codes at the end of it (in the firmware under QEMU this
 //!    stands for the hardware).
 //! 2. [`ClosedLoop::control_phase`]: the scene's target is applied as a `target` command when
-//!    it changes, the codes go through [`crate::sense`] (format, fault checks, calibration) to
+//!    it changes, the codes go through [`sonolube::sense`] (format, fault checks, calibration) to
 //!    newtons, a fault found there is the controller's `sensor_fault`, and
 //!    the controller computes the next drive command. This is the part a firmware times.
 //! 3. [`ClosedLoop::finish_step`]: the step is judged and returned as a [`StepRecord`].
@@ -19,14 +19,17 @@ use super::SimError;
 use super::commission::{COMMISSIONED, CellCalibration, commission};
 use super::judge::Judge;
 use super::quantity::{Judged, target_friction_n};
-use super::setup::controller_settings;
+use super::setup::scene_station;
 use super::summary::{Observation, RunSummary};
-use crate::control::{Controller, ExternalFault, Output, Reason, SensorFault, Settings};
-use crate::fx::Q1_31;
-use crate::plant::{AnyModel, Gaussian, LoadCellSim, Plant, SensorReadings};
-use crate::protocol::{Axis, Command, ProtocolError, SupervisorState, Target};
-use crate::scene::{Breakpoint, Scene};
-use crate::station::{CellBench, Sample, Station};
+use crate::plant::{Gaussian, LoadCellSim, Plant, SensorReadings};
+use sonolube::control::{
+    Controller, ExternalFault, Output, Reason, SensorFault, Settings, controller_settings,
+};
+use sonolube::fx::Q1_31;
+use sonolube::model::AnyModel;
+use sonolube::protocol::{Axis, Command, ProtocolError, SupervisorState, Target};
+use sonolube::scene::{Breakpoint, Scene};
+use sonolube::station::{CellBench, Sample, Station};
 
 /// One control step of a run, for plots, CSV files and checks.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -110,7 +113,9 @@ impl<'a> ClosedLoop<'a> {
     /// fidelity level this way.
     pub fn with_model(scene: &Scene<'a>, model: AnyModel) -> Result<Self, SimError> {
         let settings = controller_settings(scene);
-        let station = Station::with_model(scene, &settings, model)?;
+        let normal = super::sensor_channel(&scene.normal_cell)?;
+        let tangential = super::sensor_channel(&scene.tangential_cell)?;
+        let station = Station::with_model(scene, &settings, model, normal, tangential)?;
         Self::scripted(scene, station, COMMISSIONED)
     }
 
@@ -120,7 +125,7 @@ impl<'a> ClosedLoop<'a> {
         settings: &Settings,
         calibration: CellCalibration,
     ) -> Result<Self, SimError> {
-        Self::scripted(scene, Station::new(scene, settings)?, calibration)
+        Self::scripted(scene, scene_station(scene, settings)?, calibration)
     }
 
     /// The scripted run of `scene` on `station`: first target set, started.
@@ -145,7 +150,7 @@ impl<'a> ClosedLoop<'a> {
     /// The scene's plant under an operator's commands ([`Mode::Operated`]): commissioned
     /// cells, the scene's controller settings, idle, no target.
     pub fn operated(scene: &Scene<'a>) -> Result<Self, SimError> {
-        let station = Station::new(scene, &controller_settings(scene))?;
+        let station = scene_station(scene, &controller_settings(scene))?;
         Self::build(scene, station, COMMISSIONED, Mode::Operated)
     }
 
@@ -372,7 +377,7 @@ impl CellBench for SimulatedCells<'_, '_> {
 }
 
 /// Whether the piecewise-linear `profile` changes at `t_s` (between two breakpoints of
-/// different values), with the breakpoints in `f32` as [`crate::scene::interpolate`] uses them.
+/// different values), with the breakpoints in `f32` as [`sonolube::scene::interpolate`] uses them.
 fn ramping(profile: &[Breakpoint], t_s: f32) -> bool {
     let after = profile.partition_point(|p| p.t_s as f32 <= t_s);
     match (

@@ -21,25 +21,21 @@
 //! count and formed as `step / rate` in `f64` (a few operations per substep), so profile
 //! breakpoints and fault onsets land on the control grid exactly, however long the run.
 
-pub mod any_model;
 pub mod contact;
-pub mod exp_average;
 pub mod noise;
 pub mod profile;
 pub mod sensors;
 pub mod transducer;
 
-pub use any_model::AnyModel;
 pub use contact::{Contact, ContactTruth};
-pub use exp_average::ExpCoulombVibrated;
 pub use noise::{Gaussian, Xoshiro128};
 pub use profile::{Scenario, ScenarioInputs};
 pub use sensors::LoadCellSim;
 pub use transducer::{CurrentPhasor, ResonantTransducer};
 
-use crate::model::{FrictionModel, ModelError};
-use crate::protocol::Target;
-use crate::scene::{Channel, FaultKind, Scene};
+use sonolube::model::{AnyModel, FrictionModel, ModelError};
+use sonolube::protocol::Target;
+use sonolube::scene::{Channel, FaultKind, Scene};
 
 /// Why a plant could not be built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -8,7 +8,7 @@
 //!    generator on every sample (faulted or not, so runs with and without faults see the
 //!    same noise);
 //! 3. the converter maps +-full scale onto its codes with zero force at mid-scale (the front
-//!    ends bias the bridge amplifier to mid-supply, `crate::sense`): `code = round(zero +
+//!    ends bias the bridge amplifier to mid-supply, `sonolube::sense`): `code = round(zero +
 //!    reading / FS * zero)`, saturating at 0 and 2^bits - 1.
 //!
 //! Faults act on step 3: a disconnected cell reads its rail, a stuck one repeats the code it
@@ -17,7 +17,7 @@
 use core::f32::consts::TAU;
 
 use super::noise::Gaussian;
-use crate::scene::{FaultKind, LoadCell, Rail};
+use sonolube::scene::{FaultKind, LoadCell, Rail};
 
 /// One simulated load cell and its converter channel.
 #[derive(Debug, Clone, PartialEq)]

@@ -6,8 +6,8 @@ use heapless::Vec;
 use super::judge::{MAX_CRITERIA, MAX_FAULTS, MAX_SEGMENTS};
 use super::quantity::{Judged, Quantity};
 use crate::metrics::SegmentMetrics;
-use crate::protocol::SupervisorState;
-use crate::scene::Criterion;
+use sonolube::protocol::SupervisorState;
+use sonolube::scene::Criterion;
 
 /// One control step as the judge sees it.
 #[derive(Debug, Clone, Copy, PartialEq)]

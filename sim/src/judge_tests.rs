@@ -1,8 +1,8 @@
 //! The judge on hand-made observations: each criterion's measured value and verdict.
 
 use super::*;
-use crate::scene::{Channel, FaultEvent, FaultKind, Rail, find};
-use crate::sim::quantity::{Judged, Quantity};
+use crate::quantity::{Judged, Quantity};
+use sonolube::scene::{Channel, FaultEvent, FaultKind, Rail, find};
 
 const PERIOD_S: f32 = 1e-4;
 

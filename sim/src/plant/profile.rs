@@ -1,8 +1,8 @@
 //! The scene's inputs over time: normal load, sliding velocity, target and injected faults.
 
-use crate::protocol::Target;
-use crate::scene::{Breakpoint, Channel, FaultEvent, FaultKind, Scene, TargetPoint};
-use crate::scene::{interpolate, target_at};
+use sonolube::protocol::Target;
+use sonolube::scene::{Breakpoint, Channel, FaultEvent, FaultKind, Scene, TargetPoint};
+use sonolube::scene::{interpolate, target_at};
 
 /// The scenario inputs at one instant.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -76,7 +76,7 @@ impl<'a> Scenario<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{Rail, find};
+    use sonolube::scene::{Rail, find};
 
     #[test]
     fn the_reference_scene_steps_its_target() {

@@ -6,9 +6,9 @@
 //! opposes sliding, read positive by the tangential cell for positive sliding velocity. The
 //! models are symmetric in the sliding direction, so they are evaluated at |v|.
 
-use crate::fx::{Q1_31, Q8_24, Q16_16};
-use crate::model::{FrictionModel, ModelError, OperatingPoint};
-use crate::scene::{ModelKind, ModelSpec};
+use sonolube::fx::{Q1_31, Q8_24, Q16_16};
+use sonolube::model::{FrictionModel, ModelError, OperatingPoint};
+use sonolube::scene::{ModelKind, ModelSpec};
 
 /// The contact's state at one instant (ground truth).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -106,10 +106,10 @@ impl<M: FrictionModel> Contact<M> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fx::Q2_30;
+    use sonolube::fx::Q2_30;
 
     /// A stand-in model whose ratio is 1 - amplitude, failing above 100 N: the contact's own
-    /// arithmetic is tested here, the real models in `any_model.rs` and `crate::model`.
+    /// arithmetic is tested here, the real models in `any_model.rs` and `sonolube::model`.
     struct Linear;
 
     impl FrictionModel for Linear {

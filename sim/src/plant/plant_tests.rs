@@ -1,7 +1,7 @@
 //! Tests of the assembled plant (`mod.rs`), on the built-in scenes.
 
 use super::*;
-use crate::scene::{LoadCell, ModelKind, ModelSpec, find};
+use sonolube::scene::{LoadCell, ModelKind, ModelSpec, find};
 
 /// A Coulomb contact (seed 003: mu = 0.2), whose ratio has a closed form to check against.
 const COULOMB: ModelSpec = ModelSpec {

@@ -1,11 +1,11 @@
 //! The quantity a run is judged in, from the target's kind and the plant's ground truth
-//! (`crate::scene` criteria docs): friction force for a force target, friction coefficient
+//! (`sonolube::scene` criteria docs): friction force for a force target, friction coefficient
 //! (friction / normal load) for a coefficient target, friction ratio (friction / natural
 //! friction) against `1 - reduction` for a reduction target. Friction is taken as a
 //! magnitude (the plant signs it like the sliding velocity; the controller uses `|F_t|`).
 
 use crate::plant::GroundTruth;
-use crate::protocol::Target;
+use sonolube::protocol::Target;
 
 /// What a target holds, hence what the criteria measure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -109,7 +109,7 @@ pub fn target_friction_n(target: &Target, truth: &GroundTruth) -> f32 {
 mod tests {
     use super::*;
     use crate::plant::Plant;
-    use crate::scene::find;
+    use sonolube::scene::find;
 
     #[test]
     fn each_kind_is_judged_in_its_own_quantity() {

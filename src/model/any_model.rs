@@ -13,10 +13,10 @@ use crate::model::cube_model::CubeModel;
 use crate::model::cube_table::CubeTable;
 use crate::model::dahl::DahlParams;
 use crate::model::dahl_steady::DahlModel;
+use crate::model::exp_average::ExpCoulombVibrated;
 use crate::model::horn::UPhase;
 use crate::model::quadrature::SlipWindow;
 use crate::model::{FrictionModel, Inversion, ModelError, OperatingPoint};
-use crate::plant::exp_average::ExpCoulombVibrated;
 use crate::scene::{ModelKind, ModelSpec, RoughSurface, Scene};
 
 /// Quadrature points of the cube models: the model's default (16 points, the controller's

@@ -29,7 +29,7 @@
 
 use core::f32::consts::TAU;
 
-use crate::scene;
+use sonolube::scene;
 
 /// Current drawn at the drive frequency, relative to the drive voltage.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,7 +1,7 @@
 //! Tests of the resonant transducer (`transducer.rs`).
 
 use super::*;
-use crate::scene::{Actuator, ActuatorKind, Transducer};
+use sonolube::scene::{Actuator, ActuatorKind, Transducer};
 
 /// The seed 003 stack of the reference scene: 40 kHz, Q = 100, C0 = 300 nF, R1 = 3.1 ohm,
 /// 5.25 V at full command.

@@ -1,13 +1,13 @@
-//! Acceptance against `crate::plant`'s resonant transducer: the current waveform sampled at
+//! Acceptance of `sonolube::resonance` against `sonolube_sim::plant`'s resonant transducer: the current waveform sampled at
 //! 1 MSPS (and 250 kSPS) by a 12-bit ADC (0.5 V/A around mid-scale, 6.6 A full scale, 2 LSB RMS Gaussian
 //! noise), demodulated by the lock-in, searched and tracked, with f0 drifting.
 
-use super::*;
-use crate::drive::{Amplitude, Frequency, TimerClock};
-use crate::fx::{Q1_31, Q2_30};
-use crate::plant::{Gaussian, ResonantTransducer};
-use crate::scene::{Actuator, ActuatorKind, Transducer};
-use crate::sense::AdcFormat;
+use sonolube::drive::{Amplitude, Frequency, TimerClock};
+use sonolube::fx::{Q1_31, Q2_30};
+use sonolube::resonance::*;
+use sonolube::scene::{Actuator, ActuatorKind, Transducer};
+use sonolube::sense::AdcFormat;
+use sonolube_sim::plant::{Gaussian, ResonantTransducer};
 
 const CLOCK: TimerClock = TimerClock::G474_TIM1;
 const LOCK_IN: LockInConfig = LockInConfig {

@@ -1,9 +1,9 @@
 //! The closed loop on the built-in scenes: phases, commands, calibration, faults, capacity.
 
 use super::*;
-use crate::control::{Reason, Sensor, SensorFault, SensorFaultKind};
-use crate::protocol::{SupervisorState, Target};
-use crate::scene::{Criterion, Scene, TargetPoint, find};
+use sonolube::control::{Reason, Sensor, SensorFault, SensorFaultKind, controller_settings};
+use sonolube::protocol::{SupervisorState, Target};
+use sonolube::scene::{Criterion, Scene, TargetPoint, find};
 
 fn scene(name: &str) -> Scene<'static> {
     *find(name).expect("built in")
@@ -163,18 +163,17 @@ fn scenes_the_runner_cannot_hold_are_refused() {
 /// own model somewhere, so this cannot pass by building the own model everywhere.
 #[test]
 fn every_scene_runs_the_variant_select_names() {
-    use crate::plant::AnyModel;
-    use crate::station::Station;
-    use crate::variant::{fixed::fixed_model, select};
+    use sonolube::model::AnyModel;
+    use sonolube::variant::{fixed::fixed_model, select};
 
     let mut differs = 0;
-    for built in crate::scene::SCENES {
+    for built in sonolube::scene::SCENES {
         let selection = select(built);
         let variant = selection.variant.expect(built.name);
         let chosen = fixed_model(built, variant).expect(built.name);
         let scripted = ClosedLoop::new(built).expect(built.name);
         let operated = ClosedLoop::operated(built).expect(built.name);
-        let station = Station::for_scene(built).expect(built.name);
+        let station = scene_station(built, &controller_settings(built)).expect(built.name);
         for station in [scripted.station(), operated.station(), &station] {
             assert_eq!(station.selection(), Some(&selection), "{}", built.name);
             assert_eq!(station.model(), &chosen, "{}: {}", built.name, variant.name);
@@ -188,12 +187,12 @@ fn every_scene_runs_the_variant_select_names() {
 /// A built-in scene whose selected variant is not the model its file names, so that a run of
 /// it tells the two apart.
 fn scene_choosing_another_model() -> Scene<'static> {
-    use crate::plant::AnyModel;
+    use sonolube::model::AnyModel;
     let differs = |s: &&Scene<'static>| {
-        let chosen = crate::variant::select(s).build(s);
+        let chosen = sonolube::variant::select(s).build(s);
         chosen.is_ok() && chosen != AnyModel::new(s, &s.controller)
     };
-    *crate::scene::SCENES
+    *sonolube::scene::SCENES
         .iter()
         .find(differs)
         .expect("a scene whose choice is not its own model")
@@ -204,9 +203,9 @@ fn scene_choosing_another_model() -> Scene<'static> {
 /// measured.
 #[test]
 fn a_scene_outside_the_table_keeps_its_own_model() {
-    use crate::plant::AnyModel;
-    use crate::scene::Contents;
-    use crate::variant::{Reason, select};
+    use sonolube::model::AnyModel;
+    use sonolube::scene::Contents;
+    use sonolube::variant::{Reason, select};
 
     let horn = scene_choosing_another_model();
     let renamed = Scene {
@@ -238,7 +237,7 @@ fn a_scene_outside_the_table_keeps_its_own_model() {
     let own = AnyModel::new(&horn, &horn.controller).expect("own model");
     assert_ne!(measured.station().model(), &own);
     let budget = Scene {
-        accuracy: crate::scene::Accuracy {
+        accuracy: sonolube::scene::Accuracy {
             model_pct: 2.0 * horn.accuracy.model_pct,
             ..horn.accuracy
         },
@@ -250,7 +249,7 @@ fn a_scene_outside_the_table_keeps_its_own_model() {
 /// A run given its model runs that model, and has no selection to print.
 #[test]
 fn a_run_given_its_model_runs_it() {
-    use crate::plant::AnyModel;
+    use sonolube::model::AnyModel;
 
     let horn = scene_choosing_another_model();
     let own = AnyModel::new(&horn, &horn.controller).expect("own model");
