@@ -22,6 +22,7 @@
 
 mod closed_loop;
 mod commission;
+mod error_text;
 mod judge;
 mod quantity;
 mod setup;
