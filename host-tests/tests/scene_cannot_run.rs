@@ -2,7 +2,7 @@
 //! cannot build a run together: the message names the scene values and why (never a variant
 //! name such as `Config(Shaper(OutOfRange))`), and the exit status is 1; usage errors are 2.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn sonolube(args: &[&str]) -> (i32, String) {
@@ -32,7 +32,7 @@ fn variant_of_reference(tag: &str, edits: &[(&str, &str)]) -> PathBuf {
     file
 }
 
-fn run(file: &PathBuf) -> (i32, String) {
+fn run(file: &Path) -> (i32, String) {
     let out = file.with_extension("out");
     sonolube(&[
         "scene",
