@@ -378,3 +378,65 @@ proptest! {
         }
     }
 }
+
+/// The measurement behind the bound's documentation (`model::dahl_quadrature`): worst absolute
+/// and relative ratio error and monotonicity breaks over 3,000 seeded random points per N.
+/// Run: `cargo test -p sonolube-host --test extremes -- --ignored --nocapture dahl_survey`.
+#[test]
+#[ignore = "a measurement (prints a table), about 10 s"]
+fn dahl_survey() {
+    let mut state: u64 = 0x1234_5678_9abc_def1;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    println!("| N | alpha | worst abs | worst rel | ratio there | not monotone |");
+    println!("|---|---|---|---|---|---|");
+    for points in [64u32, 128, 256] {
+        for (label, low, high) in [("1", 1.0, 1.0), ("0.05-1", 0.05, 1.0), ("1-3", 1.0, 3.0)] {
+            let (mut worst_abs, mut worst_rel, mut at, mut breaks) = (0.0f64, 0.0f64, 0.0, 0);
+            for _ in 0..3000 {
+                let mut log = |a: f64, b: f64| (a.ln() + (b.ln() - a.ln()) * next()).exp();
+                let (w, v, zeta, k_t) = (
+                    log(0.01, 10.0),
+                    log(1e-3, 0.1),
+                    log(1e-3, 0.999),
+                    log(1e3, 1e10),
+                );
+                let (mu, f) = (0.05 + 0.95 * next(), 20e3 + 40e3 * next());
+                let alpha = low + (high - low) * next();
+                let step = 1.0 + 1e-4 * (300f64).powf(next());
+                let inputs: Inputs = [
+                    ("mu", mu),
+                    ("W", w),
+                    ("v", v),
+                    ("v_a", v / zeta),
+                    ("f", f),
+                    ("k_t", k_t),
+                    ("alpha", alpha),
+                ]
+                .iter()
+                .map(|&(k, x)| (k.to_string(), x))
+                .collect();
+                let Some((ours, theirs)) = dahl_ratio(&inputs, points) else {
+                    continue;
+                };
+                let error = (ours - theirs).abs();
+                worst_abs = worst_abs.max(error);
+                if error / theirs > worst_rel {
+                    (worst_rel, at) = (error / theirs, theirs);
+                }
+                let mut louder = inputs.clone();
+                louder.insert("v_a".into(), v / zeta * step);
+                if let Some((ours_up, theirs_up)) = dahl_ratio(&louder, points) {
+                    breaks += usize::from(theirs_up < theirs && ours_up > ours + 1e-9);
+                }
+            }
+            println!(
+                "| {points} | {label} | {worst_abs:.2e} | {worst_rel:.2e} | {at:.2e} | {breaks} / 3000 |"
+            );
+        }
+    }
+}

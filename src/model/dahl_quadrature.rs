@@ -19,12 +19,14 @@
 //! wherever the reference is (issue 15; `host-tests/tests/extremes.rs` checks it). The rule
 //! keeps the stiff limit exact (kappa x_a -> infinity: every integral -> 0) and converges as
 //! 1/n^2. Against the reference the steady-state ratio is within max(1e-3 relative, 3 / N^2
-//! absolute) over zeta in [1e-3, 0.999], kappa x_a from 1e-6 to 1e10 and alpha in (0.05, 3]:
-//! measured worst 6.9e-4 at N = 64, 1.4e-4 at N = 128, 3.6e-5 at N = 256 over 3,000 random
-//! points. The floor is absolute because the ratio is mu_i(zeta) minus a difference of two
-//! gap integrals of order 1 (over 2 pi): their quadrature error does not shrink with the ratio,
-//! so near zeta = 0, where the ratio is small, the relative error grows (1.2 % at a ratio of
-//! 2.6e-3, N = 64); raise N where that matters.
+//! absolute) over zeta in [1e-3, 0.999], k_t from 1e3 to 1e10 N/m and alpha in [0.05, 3]:
+//! worst absolute error 6.2e-4 at N = 64, 1.4e-4 at N = 128, 3.9e-5 at N = 256, and no break
+//! of monotonicity, over 3,000 seeded random points per N and alpha range
+//! (`cargo test -p sonolube-host --test extremes -- --ignored --nocapture dahl_survey`). The
+//! floor is absolute because the ratio is mu_i(zeta) minus a difference of two gap integrals
+//! of order 1 (over 2 pi): their quadrature error does not shrink with the ratio, so where the
+//! ratio is small (zeta near 0) the relative error grows (0.6 % at a ratio of 3.2e-2 for
+//! alpha < 1, N = 64); raise N where that matters.
 
 use crate::fx::{Q2_30, Q3_29, Q8_24};
 
