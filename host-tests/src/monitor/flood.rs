@@ -129,8 +129,10 @@ pub struct FloodLine {
 
 /// The error the firmware answers `line` (sent with a `\n`) with, computed with the firmware's
 /// own assembler and parser; `None` when it is a valid command, gets no reply (blank) or holds
-/// a line end (`\n` or `\r`).
+/// a line end inside it (`\n`, or a `\r` other than a trailing one: `line\r` sent with its
+/// `\n` is the one line end `\r\n`).
 pub fn expected_error(line: &[u8]) -> Option<ProtocolError> {
+    let line = line.strip_suffix(b"\r").unwrap_or(line);
     if line.contains(&b'\n') || line.contains(&b'\r') {
         return None;
     }
@@ -565,5 +567,7 @@ mod tests {
         assert_eq!(code(&[b'x'; 97]), Some(ErrorCode::LineTooLong));
         assert_eq!(code(b"st\xc3\xa9"), Some(ErrorCode::BadEncoding));
         assert_eq!(code(b"stop\r"), None);
+        assert_eq!(code(b"jump\r"), Some(ErrorCode::UnknownCommand));
+        assert_eq!(code(b"stop\rjump"), None);
     }
 }
