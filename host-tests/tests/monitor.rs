@@ -599,3 +599,58 @@ fn the_cli_prints_replies_writes_files_and_sets_its_exit_status() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// An output file that cannot be written is found before the monitor connects: nothing is sent
+/// (the listening socket never sees a connection) and the exit status is 1, with the reason.
+#[test]
+fn unwritable_output_paths_stop_the_monitor_before_it_connects() {
+    let dir = std::env::temp_dir().join(format!("sonolube-monitor-paths-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let socket = dir.join("uart.sock");
+    let listener = UnixListener::bind(&socket).unwrap();
+    listener.set_nonblocking(true).unwrap();
+    let endpoint = format!("unix:{}", socket.display());
+    let blocker = dir.join("a-file");
+    std::fs::write(&blocker, "not a folder").unwrap();
+    let under_a_file = blocker.join("run.csv");
+    for (flag, path) in [
+        ("--csv", under_a_file.to_str().unwrap()),
+        ("--svg", dir.to_str().unwrap()),
+    ] {
+        let (code, stdout, stderr) = sonolube(&[
+            "monitor",
+            "--connect",
+            &endpoint,
+            "--connect-timeout-ms",
+            "200",
+            "-c",
+            "status",
+            flag,
+            path,
+        ]);
+        assert_eq!(code, 1, "{flag} {path}: {stdout}\n{stderr}");
+        assert!(
+            stderr.contains(path) && stderr.contains("nothing was sent"),
+            "{stderr}"
+        );
+        assert!(!stdout.contains("> status"), "{stdout}");
+        assert_eq!(
+            listener.accept().map(|_| ()).unwrap_err().kind(),
+            std::io::ErrorKind::WouldBlock,
+            "{flag}: the monitor connected although its output path was bad"
+        );
+    }
+    let (code, _, stderr) = sonolube(&[
+        "monitor",
+        "--connect",
+        &endpoint,
+        "-c",
+        "status",
+        "--csv",
+        "same.out",
+        "--svg",
+        "same.out",
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

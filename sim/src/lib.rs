@@ -29,6 +29,7 @@ pub mod plant;
 
 mod closed_loop;
 mod commission;
+mod error_text;
 mod judge;
 mod quantity;
 mod setup;

@@ -122,6 +122,7 @@
 mod config;
 mod controller;
 mod error;
+mod error_text;
 mod estimate;
 mod filter;
 mod io;

@@ -32,12 +32,21 @@ impl SampledSign {
     /// Protocol from the vibration frequency `frequency_hz` (> 0), the sampling step
     /// `time_step_s` (> 0) and the window `window_s` (> 0) in SI units (f64, scene load).
     ///
-    /// Errors: `NonFinite`; `OutOfDomain` for a value <= 0, or N = round(Tw / dt) outside
-    /// 1..=1e8.
+    /// Errors: `NonFinite`; `OutOfDomain` for a value <= 0, N = round(Tw / dt) outside
+    /// 1..=1e8, or fewer than two samples per vibration period (f dt > 1/2): such samples alias
+    /// onto a slower beat of the phase, and when f dt is a whole number every sample falls at
+    /// the same phase (a "200 % reduction" from one phase of the cosine).
     pub fn new(frequency_hz: f64, time_step_s: f64, window_s: f64) -> Result<Self, ModelError> {
         let f = positive("f", frequency_hz)?;
         let dt = positive("dt", time_step_s)?;
         let tw = positive("Tw", window_s)?;
+        if f * dt > 0.5 {
+            return Err(ModelError::OutOfDomain {
+                input: "dt",
+                reason: "fewer than 2 samples per vibration period (f dt > 1/2): the samples \
+                         alias (at f dt = 1, 2, ... all fall at one phase); take dt <= 1 / (2 f)",
+            });
+        }
         let samples = libm::round(tw / dt);
         if !(1.0..=MAX_SAMPLES as f64).contains(&samples) {
             return Err(ModelError::OutOfDomain {
@@ -173,13 +182,19 @@ mod tests {
         assert!(SampledSign::new(40e3, 1e-7, 1e3).is_err());
         assert!(SampledSign::new(40e3, 0.0, 1e-3).is_err());
         assert!(SampledSign::new(f64::NAN, 1e-7, 1e-3).is_err());
-        // One sample per whole turn: every sample sits at phase 0.
-        let whole = SampledSign::new(1.0, 1.0, 10.0).unwrap();
-        assert_eq!(whole.increment, 0);
-        let m = whole.mean_sign(
+        // One sample per whole turn would put every sample at phase 0 (issue 15: v = -0.2,
+        // v_a = 0.77 read as a 200 % reduction): refused, as is anything under two samples per
+        // period; exactly two per period (phases 0 and pi) is the limit accepted.
+        assert!(SampledSign::new(40e3, 2.5e-5, 1e-3).is_err());
+        assert!(SampledSign::new(1.0, 1.0, 10.0).is_err());
+        assert!(SampledSign::new(1.0, 0.5000001, 10.0).is_err());
+        let nyquist = SampledSign::new(1.0, 0.5, 10.0).unwrap();
+        assert_eq!(nyquist.increment, 1 << 63);
+        let m = nyquist.mean_sign(
             Q8_24::from_f64(-0.5).unwrap(),
             wide::from_f64(1.0, "v_a").ok(),
         );
-        assert_eq!(m, Ok(Q2_30::ONE));
+        // Phase 0: -0.5 + 1 > 0; phase pi: -0.5 - 1 < 0: the signs cancel.
+        assert_eq!(m, Ok(Q2_30::ZERO));
     }
 }

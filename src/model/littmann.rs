@@ -77,25 +77,19 @@ impl VelocityRatio {
         })
     }
 
-    /// The ratio as f64 (tool level only): +-`f64::MAX` stands for +-infinity, like the
-    /// reference model.
-    pub fn to_f64(&self) -> f64 {
+    /// The ratio as f64 (tool level only); `None` where zeta has no value: without vibration
+    /// (v / 0), or beyond the f64 range. Never a finite stand-in such as `f64::MAX`.
+    pub fn to_f64(&self) -> Option<f64> {
         match *self {
-            Self::Zero => 0.0,
+            Self::Zero => Some(0.0),
             Self::Finite {
                 negative,
                 magnitude,
             } => {
-                let m = magnitude.to_f64().min(f64::MAX);
-                if negative { -m } else { m }
+                let m = magnitude.to_f64();
+                m.is_finite().then_some(if negative { -m } else { m })
             }
-            Self::Infinite { negative } => {
-                if negative {
-                    -f64::MAX
-                } else {
-                    f64::MAX
-                }
-            }
+            Self::Infinite { .. } => None,
         }
     }
 }
@@ -248,7 +242,7 @@ mod tests {
         let v = Q8_24::from_f64(-0.038).unwrap();
         let r = velocity_ratio(v, Some(v_a)).unwrap();
         assert!(r.is_negative());
-        assert!((r.to_f64() - v.to_f64() / 0.0683).abs() < 1e-9);
+        assert!((r.to_f64().unwrap() - v.to_f64() / 0.0683).abs() < 1e-9);
         let z = r.reversing_magnitude().unwrap();
         assert!((z.to_f64() + v.to_f64() / 0.0683).abs() < 2e-9);
         let mu = r.mu_i().unwrap().to_f64();
@@ -260,7 +254,7 @@ mod tests {
         let none = velocity_ratio(v, None).unwrap();
         assert_eq!(none, VelocityRatio::Infinite { negative: true });
         assert_eq!(none.mu_i().unwrap().to_f64(), -1.0);
-        assert_eq!(none.to_f64(), -f64::MAX);
+        assert_eq!(none.to_f64(), None);
         assert!(velocity_ratio(Q8_24::ZERO, None).is_err());
         let fast = velocity_ratio(Q8_24::from_f64(0.1).unwrap(), Some(v_a)).unwrap();
         assert_eq!(fast.reversing_magnitude(), None);

@@ -1,9 +1,13 @@
 //! Assembling received UART bytes into command lines.
 //!
 //! The assembler never blocks and never grows: it holds at most [`MAX_LINE_LEN`] bytes, and a
-//! longer line is dropped byte by byte until its newline, where it is reported once. Reporting
-//! at the newline (not at the first extra byte) keeps the one-reply-per-line rhythm a host
+//! longer line is dropped byte by byte until its line end, where it is reported once. Reporting
+//! at the line end (not at the first extra byte) keeps the one-reply-per-line rhythm a host
 //! relies on to match replies to commands.
+//!
+//! A line ends with LF, CR, or the pair CR LF (one line end, not two): programs send LF,
+//! while `screen`, `minicom` and `picocom` send a lone CR when a person presses Enter, and
+//! some terminals send CR LF.
 
 use super::error::ProtocolError;
 
@@ -19,7 +23,7 @@ enum LineFault {
     BadByte { column: u32, byte: u8 },
 }
 
-/// What a newline completed; borrows nothing, so the byte loop can return it.
+/// What a line end completed; borrows nothing, so the byte loop can return it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Completed {
     Line,
@@ -28,12 +32,13 @@ enum Completed {
 
 /// Splits a byte stream into lines.
 ///
-/// * `\n` ends a line; a `\r` anywhere is ignored, so both `\n` and `\r\n` work and a lone `\r`
-///   does nothing.
-/// * A line of more than [`MAX_LINE_LEN`] bytes (`\r` not counted) yields
-///   [`ProtocolError::LineTooLong`] once, at its `\n`.
+/// * `\n`, `\r` and the pair `\r\n` each end a line: a `\n` right after a `\r` completes
+///   nothing (it is the second half of one line end), also when the pair is split between two
+///   calls.
+/// * A line of more than [`MAX_LINE_LEN`] bytes yields [`ProtocolError::LineTooLong`] once, at
+///   its line end.
 /// * A byte other than printable ASCII (`0x20..=0x7e`) or tab yields
-///   [`ProtocolError::BadEncoding`] once, at the `\n`.
+///   [`ProtocolError::BadEncoding`] once, at the line end.
 /// * Empty lines and lines of only spaces and tabs yield nothing (no reply).
 #[derive(Debug, Clone)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -41,12 +46,14 @@ pub struct LineAssembler {
     buf: [u8; MAX_LINE_LEN],
     /// Bytes stored in `buf`.
     len: usize,
-    /// Bytes received in the current line (`\r` excluded), saturating.
+    /// Bytes received in the current line (its line end excluded), saturating.
     received: u32,
     fault: Option<LineFault>,
     /// The last byte completed a line, whose text is still in `buf` for the caller to read;
     /// the next byte starts a new line.
     completed: bool,
+    /// The last byte was a `\r`: a `\n` now is the second half of a `\r\n` line end.
+    after_cr: bool,
 }
 
 impl Default for LineAssembler {
@@ -64,6 +71,7 @@ impl LineAssembler {
             received: 0,
             fault: None,
             completed: false,
+            after_cr: false,
         }
     }
 
@@ -73,7 +81,7 @@ impl LineAssembler {
     }
 
     /// Feeds one byte. Returns the line (without terminator, printable ASCII and tabs only) or
-    /// its error when `byte` is the `\n` that completes it, `None` otherwise.
+    /// its error when `byte` is the `\n` or `\r` that completes it, `None` otherwise.
     pub fn push(&mut self, byte: u8) -> Option<Result<&str, ProtocolError>> {
         let completed = self.accept(byte)?;
         Some(self.result(completed))
@@ -101,12 +109,16 @@ impl LineAssembler {
 
     /// The state machine; `Some` when a line (or its error) is complete.
     fn accept(&mut self, byte: u8) -> Option<Completed> {
+        let follows_cr = core::mem::replace(&mut self.after_cr, byte == b'\r');
         if self.completed {
+            let after_cr = self.after_cr;
             self.reset();
+            self.after_cr = after_cr;
         }
         match byte {
-            b'\n' => return self.complete(),
-            b'\r' => return None,
+            // The `\n` of a `\r\n` pair: the `\r` already ended the line.
+            b'\n' if follows_cr => return None,
+            b'\n' | b'\r' => return self.complete(),
             _ => {}
         }
         self.received = self.received.saturating_add(1);
@@ -181,13 +193,40 @@ mod tests {
     }
 
     #[test]
-    fn splits_on_newline_and_ignores_carriage_returns() {
+    fn lf_cr_and_cr_lf_each_end_one_line() {
         assert_eq!(
             lines(b"status\nstart\r\nst\rop\n"),
-            [Ok("status".into()), Ok("start".into()), Ok("stop".into())]
+            [
+                Ok("status".into()),
+                Ok("start".into()),
+                Ok("st".into()),
+                Ok("op".into())
+            ]
         );
         assert_eq!(lines(b"status"), []);
         assert_eq!(lines(b"\r"), []);
+        // What screen, minicom and picocom send on Enter: a lone CR.
+        assert_eq!(
+            lines(b"version\rstatus\r"),
+            [Ok("version".into()), Ok("status".into())]
+        );
+    }
+
+    /// CR LF is one line end: the LF completes nothing, so a blank line after it still counts
+    /// as blank and the next line is intact; CR CR LF is two line ends (a blank line between).
+    #[test]
+    fn cr_lf_is_one_line_end_even_split_across_calls() {
+        let mut assembler = LineAssembler::new();
+        assert_eq!(assembler.push_bytes(b"stop\r"), (5, Some(Ok("stop"))));
+        assert_eq!(assembler.push_bytes(b"\n"), (1, None));
+        assert_eq!(assembler.push_bytes(b"x\n"), (2, Some(Ok("x"))));
+        let mut count = 0;
+        assembler.push_all(b"a\r\nb\r\r\nc\n\rd\n", |_| count += 1);
+        assert_eq!(count, 4);
+        // The LF of a pair is swallowed only right after the CR.
+        assert_eq!(assembler.push(b'\r'), None); // blank line: no reply
+        assert_eq!(assembler.push(b'a'), None);
+        assert_eq!(assembler.push(b'\n'), Some(Ok("a")));
     }
 
     #[test]
@@ -207,7 +246,7 @@ mod tests {
         assert_eq!(lines(&input), [Ok("x".repeat(MAX_LINE_LEN))]);
 
         let mut input = [b'x'; MAX_LINE_LEN + 1].to_vec();
-        input.extend_from_slice(b"\r\r\nstatus\n");
+        input.extend_from_slice(b"\r\r\nstatus\r");
         assert_eq!(
             lines(&input),
             [

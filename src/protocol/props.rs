@@ -19,11 +19,23 @@ use std::vec::Vec;
 /// way (split, filter, classify) rather than byte by byte.
 fn model(input: &[u8]) -> Vec<Result<Vec<u8>, ProtocolError>> {
     let mut expected = Vec::new();
-    let mut segments: Vec<&[u8]> = input.split(|&b| b == b'\n').collect();
-    // The bytes after the last newline are an incomplete line.
+    // One line end per LF, per CR, and per CR LF pair (taken left to right): turn each pair
+    // into a lone LF, then every CR into LF, and split.
+    let mut normalised = Vec::with_capacity(input.len());
+    let mut bytes = input.iter().copied().peekable();
+    while let Some(byte) = bytes.next() {
+        if byte == b'\r' {
+            bytes.next_if_eq(&b'\n');
+            normalised.push(b'\n');
+        } else {
+            normalised.push(byte);
+        }
+    }
+    let mut segments: Vec<&[u8]> = normalised.split(|&b| b == b'\n').collect();
+    // The bytes after the last line end are an incomplete line.
     segments.pop();
     for segment in segments {
-        let line: Vec<u8> = segment.iter().copied().filter(|&b| b != b'\r').collect();
+        let line: Vec<u8> = segment.to_vec();
         let first_bad = line
             .iter()
             .position(|&b| !(b == b'\t' || b == b' ' || b.is_ascii_graphic()));

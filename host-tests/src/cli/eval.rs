@@ -14,6 +14,14 @@
 //! `{"error": "..."}` for an unknown model, a missing or unknown key, an out-of-domain value,
 //! or a malformed line. A batch never stops on a bad line. Exit status: 0, or 1 when the single
 //! evaluation failed, 2 on usage errors.
+//!
+//! At the extremes (`fixed_eval::extremes`): an output that is undefined at the inputs (zeta
+//! without vibration, a ratio to or a percent reduction of zero friction) is `null` on the side
+//! where it is undefined, and `"undefined": {key: reason}` says why; it is never a finite
+//! stand-in nor a limit value. `"flags": {key: reason}` names an input `f` outside the 20-60 kHz
+//! drive band and an output outside its physical range (for example a friction ratio below
+//! zero); the numbers are kept, the flag says why they are not physical. Both fields are
+//! present only when not empty.
 
 use std::collections::BTreeMap;
 use std::io::{BufRead, Write};
@@ -21,6 +29,7 @@ use std::process::ExitCode;
 
 use serde_json::{Map, Value, json};
 
+use crate::fixed_eval::extremes::{flags, undefined_keys, undefined_reason};
 use crate::fixed_eval::{Outputs, eval_fixed_named, models};
 use crate::reference::eval_named;
 
@@ -176,16 +185,53 @@ pub fn evaluate(
         Err(e) => return error(e.to_string()),
     };
     match eval_fixed_named(model, inputs, variant) {
-        Ok(outputs) => json!({ "outputs": as_json(&outputs), "reference": as_json(&reference) }),
+        Ok(outputs) => answer(model, inputs, &outputs, &reference),
         Err(e) => error(format!("fixed point: {e}")),
     }
 }
 
-fn as_json(outputs: &Outputs) -> Value {
-    let map: Map<String, Value> = outputs
+/// The JSON answer: both sides with `null` for their undefined outputs, the reasons, the flags.
+fn answer(
+    model: &str,
+    inputs: &BTreeMap<String, f64>,
+    fixed: &Outputs,
+    reference: &Outputs,
+) -> Value {
+    let mut undefined = Map::new();
+    let mut missing: Vec<&str> = undefined_keys(model, fixed);
+    missing.extend(undefined_keys(model, reference));
+    // A key one side gives and the other does not is undefined on the other side.
+    missing.extend(fixed.keys().filter(|k| !reference.contains_key(*k)));
+    missing.extend(reference.keys().filter(|k| !fixed.contains_key(*k)));
+    for key in missing {
+        let why = undefined_reason(model, key).unwrap_or("not computed on this side");
+        undefined.insert(key.to_string(), json!(why));
+    }
+    let mut result = Map::new();
+    result.insert("outputs".into(), as_json(fixed, &undefined));
+    result.insert("reference".into(), as_json(reference, &undefined));
+    if !undefined.is_empty() {
+        result.insert("undefined".into(), Value::Object(undefined));
+    }
+    let flags: Map<String, Value> = flags(model, inputs, fixed, reference)
+        .into_iter()
+        .map(|(key, why)| (key.to_string(), json!(why)))
+        .collect();
+    if !flags.is_empty() {
+        result.insert("flags".into(), Value::Object(flags));
+    }
+    Value::Object(result)
+}
+
+/// The side's outputs, with `null` for each key in `undefined` it does not give.
+fn as_json(outputs: &Outputs, undefined: &Map<String, Value>) -> Value {
+    let mut map: Map<String, Value> = outputs
         .iter()
         .map(|(key, value)| (key.to_string(), json!(value)))
         .collect();
+    for key in undefined.keys() {
+        map.entry(key.clone()).or_insert(Value::Null);
+    }
     Value::Object(map)
 }
 

@@ -12,7 +12,9 @@
 //! Exit status: 0 when every reply was `ok` (and the acceptance test passed, when asked); 1 when
 //! a command got an `err` reply (unless `--allow-errors`), a check failed, the connection was
 //! lost or timed out, the firmware sent malformed lines, or an output file could not be
-//! written; 2 for a usage error.
+//! written; 2 for a usage error. The output files (`--csv`, `--svg`) are checked before
+//! anything is sent: a path that cannot be written ends the run there, with exit status 1 and
+//! the reason, so a session with the board is never run only to lose its record.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -55,6 +57,9 @@ interface after the commands.
   --telemetry-hz N         telemetry rate of the acceptance test (default 1000; lower it on a
                            115200-baud serial port, the observation lengthens to match)
 
+The --csv and --svg paths are checked before connecting: if one cannot be written, nothing
+is sent.
+
 exit status: 0 all ok; 1 an err reply, a failed check, a lost or silent connection, malformed
 lines from the firmware, or an unwritable output file; 2 a usage error
 ";
@@ -86,6 +91,21 @@ pub fn run(args: &[String]) -> ExitCode {
     };
     if options.steps.is_empty() && !options.acceptance {
         eprint!("sonolube monitor: nothing to do: give -c, --script or --acceptance\n\n{USAGE}");
+        return ExitCode::from(2);
+    }
+    for path in [&options.csv, &options.svg].into_iter().flatten() {
+        if let Err(why) = check_writable(path) {
+            eprintln!("sonolube monitor: {why} (checked before connecting; nothing was sent)");
+            return ExitCode::FAILURE;
+        }
+    }
+    if let (Some(csv), Some(svg)) = (&options.csv, &options.svg)
+        && csv == svg
+    {
+        eprintln!(
+            "sonolube monitor: --csv and --svg both name {}: one would overwrite the other",
+            csv.display()
+        );
         return ExitCode::from(2);
     }
     let mut link = match Link::connect(&options.endpoint, options.link) {
@@ -193,6 +213,30 @@ fn summarize(session: &Session, out: &mut dyn Write) -> bool {
         eprintln!("  {example}");
     }
     false
+}
+
+/// Checks that `path` can be written: its folder exists or is created, and the file opens for
+/// writing (an existing file is left as it is; a file created by the check is removed again).
+fn check_writable(path: &Path) -> Result<(), String> {
+    if path.is_dir() {
+        return Err(format!("{}: is a directory, not a file", path.display()));
+    }
+    if let Some(dir) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("{}: cannot create its folder: {e}", path.display()))?;
+    }
+    let existed = path.exists();
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(path)
+        .map_err(|e| format!("{}: cannot be written: {e}", path.display()))?;
+    if !existed {
+        std::fs::remove_file(path)
+            .map_err(|e| format!("{}: cannot remove the probe file: {e}", path.display()))?;
+    }
+    Ok(())
 }
 
 fn write(out: &mut dyn Write, path: &Path, text: &str) -> bool {
@@ -360,5 +404,22 @@ mod tests {
         ] {
             assert!(parse_args(&args(bad)).is_err(), "{bad:?}");
         }
+    }
+
+    #[test]
+    fn output_paths_are_checked_without_leaving_files() {
+        let dir = std::env::temp_dir().join(format!("sonolube-monitor-{}", std::process::id()));
+        let fresh = dir.join("sub").join("run.csv");
+        assert_eq!(check_writable(&fresh), Ok(()));
+        assert!(!fresh.exists(), "the probe file is removed");
+        assert!(check_writable(&dir).unwrap_err().contains("is a directory"));
+        let kept = dir.join("kept.csv");
+        std::fs::write(&kept, "old").unwrap();
+        assert_eq!(check_writable(&kept), Ok(()));
+        assert_eq!(std::fs::read_to_string(&kept).unwrap(), "old");
+        // A folder that cannot exist: its parent is a file.
+        let under_file = kept.join("x.svg");
+        assert!(check_writable(&under_file).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -11,8 +11,12 @@
 //!
 //! `NAME` is a built-in scene (`scenes/*.toml`, compiled in); `--file` runs any scene file
 //! (its `name` must match `NAME` when both are given). Files go to `DIR` (default
-//! `target/scenes/`): `NAME.csv` and `NAME.svg`. Exit status: 0 when every criterion passes,
-//! 1 when one fails (or a scene cannot run), 2 for a usage error. The output is deterministic.
+//! `target/scenes/`): `NAME.csv` and `NAME.svg`. Exit status: 0 when every criterion passes;
+//! 1 when one fails, or the scene cannot run: a `--file` that cannot be read or breaks the
+//! schema, or a scene whose values are each in range but cannot build a run together (the
+//! message names the scene values and why, see `why.rs`); 2 for a usage error (an unknown
+//! option or scene name, a missing value, `NAME` and `--file` naming different scenes). The
+//! output is deterministic.
 //!
 //! # CSV columns
 //!
@@ -40,6 +44,7 @@
 mod csv;
 mod figure;
 mod report;
+mod why;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -55,7 +60,10 @@ pub use csv::csv;
 pub use report::{model_line, model_name};
 
 const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml]\n       \
-                     sonolube scene --all [--out DIR]\n";
+                     sonolube scene --all [--out DIR]\n\
+                     exit status: 0 every criterion passes; 1 one fails, or the scene cannot \
+                     run (a file that cannot be read or is invalid, values that cannot build a \
+                     run); 2 a usage error\n";
 
 /// Entry point: `args` are the arguments after `scene`.
 pub fn run(args: &[String]) -> ExitCode {
@@ -97,7 +105,10 @@ pub fn run(args: &[String]) -> ExitCode {
         (Some(path), _) => {
             loaded = match LoadedScene::load(path) {
                 Ok(loaded) => loaded,
-                Err(error) => return usage(&error.to_string()),
+                Err(error) => {
+                    eprintln!("sonolube scene: the scene cannot run: {error}");
+                    return ExitCode::FAILURE;
+                }
             };
             let scene = loaded.scene();
             if name.as_deref().is_some_and(|n| n != scene.name) {
@@ -188,7 +199,7 @@ pub struct SceneRun {
 /// Runs `scene`, writes its CSV and SVG to `out`, returns the summary, the report text and
 /// the model the controller ran.
 pub fn run_one(scene: &Scene<'_>, out: &Path) -> Result<SceneRun, String> {
-    let mut sim = ClosedLoop::new(scene).map_err(|e| format!("cannot build the run: {e:?}"))?;
+    let mut sim = ClosedLoop::new(scene).map_err(|e| why::cannot_run(scene, &e))?;
     let mut records = Vec::with_capacity(scene.step_count() as usize);
     while let Some(record) = sim.step() {
         records.push(record);

@@ -23,6 +23,7 @@
 
 use std::collections::BTreeMap;
 
+use super::defined;
 use super::keys::Keys;
 use sonolube::fx::{Q, Q1_31, Q2_30, Q8_24, Q16_16};
 use sonolube::model::ModelError;
@@ -97,7 +98,9 @@ impl Keys<'_> {
         move |e| format!("{}: {e}", self.model)
     }
 
-    /// A velocity in m/s in the finest format that holds it.
+    /// A velocity in m/s in the finest format that holds it. A velocity that is not zero but
+    /// rounds to zero (below 2^-25 m/s, subnormal ones included) is an error: the fixed point
+    /// would read it as "no sliding" while the reference uses its direction.
     fn speed(&mut self, key: &'static str) -> Result<Speed, String> {
         let v = self.get(key)?;
         let speed = if v.abs() < 127.0 {
@@ -105,8 +108,27 @@ impl Keys<'_> {
         } else {
             Speed::Wide(Q16_16::from_f64(v).map_err(|e| format!("{key}: {e}"))?)
         };
+        self.nonzero_kept(key, v, speed.to_f64(), "Q8.24, 6.0e-8 m/s")?;
         self.record(key, speed.to_f64());
         Ok(speed)
+    }
+
+    /// Error when a nonzero input `value` reached the fixed point as zero (`quantized`).
+    fn nonzero_kept(
+        &self,
+        key: &str,
+        value: f64,
+        quantized: f64,
+        resolution: &str,
+    ) -> Result<(), String> {
+        if value != 0.0 && quantized == 0.0 {
+            return Err(format!(
+                "{}: input {key} = {value:e} is not zero but below the fixed-point resolution \
+                 ({resolution}): it would reach the fixed point as 0, while the reference uses it",
+                self.model
+            ));
+        }
+        Ok(())
     }
 
     /// A force in N in the finest format that holds `headroom` times it.
@@ -123,6 +145,7 @@ impl Keys<'_> {
         } else {
             Load::L8(Q::<8>::from_f64(w).map_err(fail)?)
         };
+        self.nonzero_kept(key, w, load.to_f64(), "Q1.31, 4.7e-10 N")?;
         self.record(key, load.to_f64());
         Ok(load)
     }
@@ -239,12 +262,14 @@ fn coulomb_average(keys: &mut Keys<'_>) -> Result<Outputs, String> {
         )
     }))
     .map_err(keys.err())?;
-    Ok(Outputs::from([
-        ("v_a", value(a.0)),
+    // A percent reduction of zero friction (v = 0, mu = 0 or W = 0) is undefined.
+    let reduction = (a.2 != 0.0).then_some(100.0 * a.4);
+    Ok(defined([
+        ("v_a", Some(value(a.0))),
         ("zeta", a.1),
-        ("F_novib", a.2),
-        ("F_avg", a.3),
-        ("reduction_pct", 100.0 * a.4),
+        ("F_novib", Some(a.2)),
+        ("F_avg", Some(a.3)),
+        ("reduction_pct", reduction),
     ]))
 }
 
@@ -265,10 +290,12 @@ fn coulomb_sampled(keys: &mut Keys<'_>) -> Result<Outputs, String> {
     }
     .map_err(keys.err())?
     .to_f64();
-    let direction = if v.to_f64() < 0.0 { -1.0 } else { 1.0 };
-    Ok(Outputs::from([
-        ("mean_sign", mean),
-        ("reduction_pct", 100.0 * (1.0 - direction * mean)),
+    // No sliding, no friction without vibration: its percent reduction is undefined.
+    let direction = v.to_f64().signum();
+    let reduction = (v.to_f64() != 0.0).then_some(100.0 * (1.0 - direction * mean));
+    Ok(defined([
+        ("mean_sign", Some(mean)),
+        ("reduction_pct", reduction),
     ]))
 }
 
@@ -303,14 +330,16 @@ fn dahl_steady(keys: &mut Keys<'_>) -> Result<Outputs, String> {
         )
     }))
     .map_err(keys.err())?;
-    Ok(Outputs::from([
+    // F_avg / (mu W sgn v) and its percent reduction are undefined without sliding.
+    let ratio = (v.to_f64() != 0.0).then_some(s.1);
+    Ok(defined([
         ("zeta", s.0.velocity_ratio.to_f64()),
-        ("x_a", value(s.0.vibration_amplitude)),
-        ("kxa", value(s.0.stiffness_amplitude)),
-        ("F_novib", s.2),
-        ("F_avg", s.3),
-        ("ratio", s.1),
-        ("reduction_pct", 100.0 * (1.0 - s.1)),
+        ("x_a", Some(value(s.0.vibration_amplitude))),
+        ("kxa", Some(value(s.0.stiffness_amplitude))),
+        ("F_novib", Some(s.2)),
+        ("F_avg", Some(s.3)),
+        ("ratio", ratio),
+        ("reduction_pct", ratio.map(|r| 100.0 * (1.0 - r))),
     ]))
 }
 
@@ -328,9 +357,12 @@ fn dahl_window(keys: &mut Keys<'_>) -> Result<Outputs, String> {
         .average(w, v, amplitude, f0)
         .map(|o| (o.average_friction.to_f64(), o.reduction().to_f64())))
     .map_err(keys.err())?;
-    Ok(Outputs::from([
-        ("F_avg", out.0),
-        ("reduction_pct", 100.0 * out.1),
+    Ok(defined([
+        ("F_avg", Some(out.0)),
+        (
+            "reduction_pct",
+            (v.to_f64() != 0.0).then_some(100.0 * out.1),
+        ),
     ]))
 }
 

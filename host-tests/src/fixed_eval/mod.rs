@@ -4,12 +4,22 @@
 pub mod contact_cube;
 pub mod coulomb_dahl;
 pub mod dahl_transient;
+pub mod extremes;
 mod keys;
 
 use std::collections::BTreeMap;
 
-/// Output map: key -> value in SI units (percent for `*_pct`).
+/// Output map: key -> value in SI units (percent for `*_pct`). An output that is undefined at
+/// the given inputs is absent, exactly as in [`crate::reference::eval_named`].
 pub type Outputs = BTreeMap<&'static str, f64>;
+
+/// The outputs that are defined (`Some`), keyed.
+pub(crate) fn defined<const N: usize>(pairs: [(&'static str, Option<f64>); N]) -> Outputs {
+    pairs
+        .into_iter()
+        .filter_map(|(key, value)| value.map(|value| (key, value)))
+        .collect()
+}
 
 /// Input map: key -> value in SI units.
 pub type Inputs = BTreeMap<String, f64>;

@@ -129,14 +129,16 @@ pub struct FloodLine {
 
 /// The error the firmware answers `line` (sent with a `\n`) with, computed with the firmware's
 /// own assembler and parser; `None` when it is a valid command, gets no reply (blank) or holds
-/// a `\n`.
+/// a line end inside it (`\n`, or a `\r` other than a trailing one: `line\r` sent with its
+/// `\n` is the one line end `\r\n`).
 pub fn expected_error(line: &[u8]) -> Option<ProtocolError> {
-    if line.contains(&b'\n') {
+    let line = line.strip_suffix(b"\r").unwrap_or(line);
+    if line.contains(&b'\n') || line.contains(&b'\r') {
         return None;
     }
     let mut assembler = LineAssembler::new();
     for &byte in line {
-        // No newline in `line`, so nothing completes before the one pushed below.
+        // No line end in `line`, so nothing completes before the `\n` pushed below.
         let _ = assembler.push(byte);
     }
     match assembler.push(b'\n')? {
@@ -463,8 +465,8 @@ fn oversized(rng: &mut Rng) -> Vec<u8> {
     line
 }
 
-/// Bytes that are neither printable ASCII nor tab, without `\n` (which would end the line)
-/// and `\r` (which the firmware ignores).
+/// Bytes that are neither printable ASCII nor tab, without `\n` and `\r` (either ends the
+/// line).
 fn bad_byte(rng: &mut Rng) -> u8 {
     loop {
         let byte = match rng.below(3) {
@@ -565,5 +567,7 @@ mod tests {
         assert_eq!(code(&[b'x'; 97]), Some(ErrorCode::LineTooLong));
         assert_eq!(code(b"st\xc3\xa9"), Some(ErrorCode::BadEncoding));
         assert_eq!(code(b"stop\r"), None);
+        assert_eq!(code(b"jump\r"), Some(ErrorCode::UnknownCommand));
+        assert_eq!(code(b"stop\rjump"), None);
     }
 }

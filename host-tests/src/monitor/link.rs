@@ -179,8 +179,9 @@ impl Link {
         let mut bytes = Vec::with_capacity(line.len() + 1);
         bytes.extend_from_slice(line);
         bytes.push(b'\n');
-        if gets_reply(line) {
-            self.shared.lock().commands_sent += 1;
+        let replies = replies(line);
+        if replies > 0 {
+            self.shared.lock().commands_sent += replies;
         }
         self.writer
             .write_all(&bytes)
@@ -213,9 +214,9 @@ impl Link {
     /// Sends one command line and returns its reply (waiting at most the reply timeout).
     /// The line must not be blank: blank lines get no reply.
     pub fn command(&mut self, line: &str) -> Result<ReplyLine, LinkError> {
-        if !gets_reply(line.as_bytes()) {
+        if replies(line.as_bytes()) != 1 {
             return Err(LinkError::BadLine(format!(
-                "{line:?}: a blank line gets no reply"
+                "{line:?}: not one line with one reply (blank, or a CR inside it)"
             )));
         }
         self.send(line.as_bytes())?;
@@ -246,9 +247,9 @@ impl Link {
         window: usize,
         mut on_reply: impl FnMut(usize, ReplyLine),
     ) -> Result<(), LinkError> {
-        if let Some(blank) = lines.iter().find(|line| !gets_reply(line)) {
+        if let Some(blank) = lines.iter().find(|line| replies(line) != 1) {
             return Err(LinkError::BadLine(format!(
-                "{:?}: a blank line gets no reply",
+                "{:?}: not one line with one reply (blank, or a CR inside it)",
                 String::from_utf8_lossy(blank)
             )));
         }
@@ -405,15 +406,15 @@ impl Drop for Link {
     }
 }
 
-/// Whether the firmware answers `line` (sent with a `\n`): its line assembler yields a line or
-/// a line error for it, rather than skipping it as blank.
-fn gets_reply(line: &[u8]) -> bool {
+/// How many replies the firmware gives `line` sent with a `\n`: how many lines or line errors
+/// its assembler yields (a blank line none; a `\r` also ends a line, and a trailing one with
+/// the `\n` is the single line end `\r\n`).
+fn replies(line: &[u8]) -> u64 {
     let mut assembler = LineAssembler::new();
-    for &byte in line {
-        // `line` holds no newline (checked by the callers' `send`), so nothing completes here.
-        let _ = assembler.push(byte);
-    }
-    assembler.push(b'\n').is_some()
+    let mut count = 0;
+    assembler.push_all(line, |_| count += 1);
+    assembler.push_all(b"\n", |_| count += 1);
+    count
 }
 
 /// The receiving thread: splits the byte stream into lines and files each in the inbox.

@@ -11,15 +11,20 @@ use super::numerics::acos_stable;
 
 /// Velocity ratio zeta = v / v_a (seed 001 eq 1, seed 003 "xi").
 ///
-/// Without vibration (`v_a = 0`) zeta is infinite; it is reported as `+-f64::MAX` so that every
-/// output stays finite (any |zeta| >= 1 means "no reversal"). No motion at all (`v = v_a = 0`)
-/// leaves the friction force undetermined (static friction): [`RefError::ModelValidity`].
-pub fn velocity_ratio(sliding_velocity: f64, vibration_velocity: f64) -> Result<f64, RefError> {
+/// Without vibration (`v_a = 0`) zeta has no value (v / 0): `None`, which the model outputs
+/// report as undefined, never as a finite stand-in; the friction is then the full Coulomb level
+/// (no velocity reversal). A ratio beyond the f64 range (v_a tiny, not zero) is also `None`.
+/// No motion at all (`v = v_a = 0`) leaves the friction force undetermined (static friction):
+/// [`RefError::ModelValidity`].
+pub fn velocity_ratio(
+    sliding_velocity: f64,
+    vibration_velocity: f64,
+) -> Result<Option<f64>, RefError> {
     if vibration_velocity > 0.0 {
         let zeta = sliding_velocity / vibration_velocity;
-        Ok(zeta.clamp(-f64::MAX, f64::MAX))
+        Ok(zeta.is_finite().then_some(zeta))
     } else if sliding_velocity != 0.0 {
-        Ok(f64::MAX.copysign(sliding_velocity))
+        Ok(None)
     } else {
         Err(RefError::ModelValidity(
             "no relative motion (v = 0 and no vibration): friction is static and undetermined"
@@ -28,10 +33,21 @@ pub fn velocity_ratio(sliding_velocity: f64, vibration_velocity: f64) -> Result<
     }
 }
 
-/// Direction used to normalise friction ratios: sgn(v), taken as +1 at v = 0 (the continuous
-/// extension from v -> 0+, where every ratio below tends to 0 anyway).
-pub fn reference_direction(sliding_velocity: f64) -> f64 {
-    if sliding_velocity < 0.0 { -1.0 } else { 1.0 }
+/// Direction used to normalise friction ratios: sgn(v); `None` at v = 0, where the friction
+/// without vibration is zero and a ratio to it (or a percent reduction of it) is undefined.
+pub fn reference_direction(sliding_velocity: f64) -> Option<f64> {
+    if sliding_velocity < 0.0 {
+        Some(-1.0)
+    } else if sliding_velocity > 0.0 {
+        Some(1.0)
+    } else {
+        None
+    }
+}
+
+/// The mu_i of a velocity ratio from [`velocity_ratio`]: sgn(v) without a finite ratio.
+pub fn littmann_of(zeta: Option<f64>, sliding_velocity: f64) -> f64 {
+    zeta.map_or(1.0_f64.copysign(sliding_velocity), littmann_ratio)
 }
 
 /// Littmann friction ratio mu_i(zeta) = (2/pi) asin(zeta) for |zeta| <= 1, sgn(zeta) beyond
@@ -84,14 +100,15 @@ pub struct CoulombAvgInput {
 pub struct CoulombAvgOutput {
     /// Vibration velocity amplitude v_a = 2 pi f x_a in m/s.
     pub vibration_velocity: f64,
-    /// Velocity ratio zeta = v / v_a (`+-f64::MAX` without vibration).
-    pub velocity_ratio: f64,
+    /// Velocity ratio zeta = v / v_a; `None` without vibration (undefined: v / 0).
+    pub velocity_ratio: Option<f64>,
     /// Friction without vibration mu W sgn(v) in N (0 at v = 0).
     pub friction_without_vibration: f64,
     /// Period-averaged friction mu W mu_i(zeta) in N.
     pub average_friction: f64,
-    /// 100 (1 - F_avg / F_novib) = 100 (1 - mu_i(|zeta|)) in %, in [0, 100].
-    pub reduction_pct: f64,
+    /// 100 (1 - F_avg / F_novib) = 100 (1 - mu_i(|zeta|)) in %, in [0, 100]; `None` when
+    /// F_novib = 0 (v = 0, mu = 0 or W = 0): a reduction of zero friction is undefined.
+    pub reduction_pct: Option<f64>,
 }
 
 /// Exact period average of Coulomb friction mu W sgn(v + v_a cos(2 pi f t)) (seed 003 eq 4,
@@ -105,12 +122,13 @@ pub fn coulomb_avg_friction(input: &CoulombAvgInput) -> Result<CoulombAvgOutput,
     let v_a = 2.0 * PI * f * x_a;
     let zeta = velocity_ratio(v, v_a)?;
     let level = mu * load;
+    let natural = if v == 0.0 { 0.0 } else { level.copysign(v) };
     Ok(CoulombAvgOutput {
         vibration_velocity: v_a,
         velocity_ratio: zeta,
-        friction_without_vibration: if v == 0.0 { 0.0 } else { level.copysign(v) },
-        average_friction: level * littmann_ratio(zeta),
-        reduction_pct: 100.0 * littmann_reduction(zeta),
+        friction_without_vibration: natural,
+        average_friction: level * littmann_of(zeta, v),
+        reduction_pct: (natural != 0.0).then(|| 100.0 * zeta.map_or(0.0, littmann_reduction)),
     })
 }
 
@@ -123,7 +141,7 @@ pub struct SampledSignInput {
     pub vibration_velocity: f64,
     /// Vibration frequency f in Hz (> 0).
     pub frequency: f64,
-    /// Sampling step dt in s (> 0).
+    /// Sampling step dt in s, 0 < dt <= 1 / (2 f) (two samples per period or more).
     pub time_step: f64,
     /// Averaging window Tw in s (> 0); N = round(Tw / dt) samples, 1 <= N <= 1e8.
     pub window: f64,
@@ -134,8 +152,8 @@ pub struct SampledSignInput {
 pub struct SampledSignOutput {
     /// (1/N) sum_k sgn(v + v_a cos(2 pi f k dt)), k = 0..N-1, with sgn(0) = 0; in [-1, 1].
     pub mean_sign: f64,
-    /// 100 (1 - sgn(v) mean_sign) in % (sgn taken as +1 at v = 0).
-    pub reduction_pct: f64,
+    /// 100 (1 - sgn(v) mean_sign) in %; `None` at v = 0 (no friction without vibration).
+    pub reduction_pct: Option<f64>,
 }
 
 /// Largest number of samples [`coulomb_sampled_avg_sign`] accepts.
@@ -151,6 +169,14 @@ pub fn coulomb_sampled_avg_sign(input: &SampledSignInput) -> Result<SampledSignO
     let f = positive("f", input.frequency)?;
     let dt = positive("dt", input.time_step)?;
     let tw = positive("Tw", input.window)?;
+    if f * dt > 0.5 {
+        return Err(RefError::OutOfDomain {
+            key: "dt",
+            value: dt,
+            rule: "fewer than 2 samples per vibration period (f dt > 1/2): the samples alias \
+                   (at f dt = 1, 2, ... all fall at one phase); take dt <= 1 / (2 f)",
+        });
+    }
     let samples = (tw / dt).round();
     if !(1.0..=MAX_SAMPLES).contains(&samples) {
         return Err(RefError::OutOfDomain {
@@ -170,7 +196,7 @@ pub fn coulomb_sampled_avg_sign(input: &SampledSignInput) -> Result<SampledSignO
     let mean_sign = sum as f64 / samples;
     Ok(SampledSignOutput {
         mean_sign,
-        reduction_pct: 100.0 * (1.0 - reference_direction(v) * mean_sign),
+        reduction_pct: reference_direction(v).map(|s| 100.0 * (1.0 - s * mean_sign)),
     })
 }
 

@@ -36,8 +36,8 @@ pub struct DahlSteadyInput {
 /// Outputs of [`dahl_steady`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DahlSteadyOutput {
-    /// zeta = v / v_a (`+-f64::MAX` without vibration).
-    pub velocity_ratio: f64,
+    /// zeta = v / v_a; `None` without vibration (undefined: v / 0).
+    pub velocity_ratio: Option<f64>,
     /// Displacement amplitude x_a = v_a / (2 pi f) in m.
     pub vibration_amplitude: f64,
     /// kappa x_a = k_t x_a / (mu W), dimensionless: the model's stiffness parameter.
@@ -46,10 +46,10 @@ pub struct DahlSteadyOutput {
     pub friction_without_vibration: f64,
     /// Period-averaged friction in the periodic steady state, in N.
     pub average_friction: f64,
-    /// F_avg / (mu W sgn v), dimensionless (sgn taken as +1 at v = 0); in [-1, 1].
-    pub friction_ratio: f64,
-    /// 100 (1 - ratio) in %.
-    pub reduction_pct: f64,
+    /// F_avg / (mu W sgn v), dimensionless, in [-1, 1]; `None` at v = 0 (F_novib = 0).
+    pub friction_ratio: Option<f64>,
+    /// 100 (1 - ratio) in %; `None` at v = 0.
+    pub reduction_pct: Option<f64>,
 }
 
 /// Validated common Dahl inputs: (Coulomb level mu W, drive).
@@ -109,7 +109,7 @@ pub fn dahl_steady(input: &DahlSteadyInput) -> Result<DahlSteadyOutput, RefError
     )?;
     let v = drive.sliding_velocity;
     let average = steady_average(&drive)?;
-    let ratio = average * reference_direction(v);
+    let ratio = reference_direction(v).map(|s| average * s);
     Ok(DahlSteadyOutput {
         velocity_ratio: velocity_ratio(v, drive.vibration_velocity)?,
         vibration_amplitude: drive.vibration_velocity / (2.0 * PI * input.frequency),
@@ -117,7 +117,7 @@ pub fn dahl_steady(input: &DahlSteadyInput) -> Result<DahlSteadyOutput, RefError
         friction_without_vibration: if v == 0.0 { 0.0 } else { level.copysign(v) },
         average_friction: level * average,
         friction_ratio: ratio,
-        reduction_pct: 100.0 * (1.0 - ratio),
+        reduction_pct: ratio.map(|r| 100.0 * (1.0 - r)),
     })
 }
 
@@ -147,8 +147,8 @@ pub struct DahlWindowInput {
 pub struct DahlWindowOutput {
     /// Time average of F over [0, Tw] in N.
     pub average_friction: f64,
-    /// 100 (1 - F_avg / (mu W sgn v)) in % (sgn taken as +1 at v = 0).
-    pub reduction_pct: f64,
+    /// 100 (1 - F_avg / (mu W sgn v)) in %; `None` at v = 0 (no friction without vibration).
+    pub reduction_pct: Option<f64>,
 }
 
 /// Dahl model with the vibration switched on at t = 0 from F = f0 mu W, averaged over
@@ -183,7 +183,8 @@ pub fn dahl_window(input: &DahlWindowInput) -> Result<DahlWindowOutput, RefError
     let average = window_average(&drive, f0, 2.0 * PI * periods)?;
     Ok(DahlWindowOutput {
         average_friction: level * average,
-        reduction_pct: 100.0 * (1.0 - average * reference_direction(drive.sliding_velocity)),
+        reduction_pct: reference_direction(drive.sliding_velocity)
+            .map(|s| 100.0 * (1.0 - average * s)),
     })
 }
 

@@ -37,8 +37,18 @@ pub const MODELS: &[&str] = &[
     "actuator",
 ];
 
-/// Output map of [`eval_named`]: key -> value in SI units (percent for `*_pct`).
+/// Output map of [`eval_named`]: key -> value in SI units (percent for `*_pct`). A quantity
+/// that is undefined at the given inputs (a velocity ratio without vibration, a ratio to or a
+/// percent reduction of zero friction) is absent: never a finite stand-in or a limit value.
 pub type Outputs = BTreeMap<&'static str, f64>;
+
+/// The outputs that are defined (`Some`), keyed.
+fn defined<const N: usize>(pairs: [(&'static str, Option<f64>); N]) -> Outputs {
+    pairs
+        .into_iter()
+        .filter_map(|(key, value)| value.map(|value| (key, value)))
+        .collect()
+}
 
 /// Evaluates reference model `model` at `inputs` (SI units) with `variant` choices.
 ///
@@ -63,6 +73,11 @@ pub type Outputs = BTreeMap<&'static str, f64>;
 /// `E_star_rule` = seed000 (default) | seed001; `contact` = ep (default) | el; `window` = vpos
 /// (default) | literal_cos; `u_phase` = inphase (default) | quadrature; `quadrature_points` = a
 /// whole number >= 1, accepted and ignored (the reference always uses its converged integral).
+///
+/// Undefined outputs are left out of the map: `zeta` without vibration (`coulomb_avg_friction`,
+/// `dahl_steady`), `reduction_pct` when the friction without vibration is zero
+/// (`coulomb_avg_friction`, `coulomb_sampled_avg_sign`, `dahl_steady`, `dahl_window` at v = 0,
+/// and mu W = 0 for `coulomb_avg_friction`), `ratio` of `dahl_steady` at v = 0.
 ///
 /// Returns the model's outputs keyed as in the project's model table, or a [`RefError`] for an
 /// unknown model, a missing / unknown / non-finite input, an unknown variant key or value, an
@@ -116,11 +131,11 @@ fn evaluate(
                 vibration_amplitude: i.get("x_a")?,
                 frequency: i.get("f")?,
             })?;
-            Outputs::from([
-                ("v_a", o.vibration_velocity),
+            defined([
+                ("v_a", Some(o.vibration_velocity)),
                 ("zeta", o.velocity_ratio),
-                ("F_novib", o.friction_without_vibration),
-                ("F_avg", o.average_friction),
+                ("F_novib", Some(o.friction_without_vibration)),
+                ("F_avg", Some(o.average_friction)),
                 ("reduction_pct", o.reduction_pct),
             ])
         }
@@ -132,8 +147,8 @@ fn evaluate(
                 time_step: i.get("dt")?,
                 window: i.get("Tw")?,
             })?;
-            Outputs::from([
-                ("mean_sign", o.mean_sign),
+            defined([
+                ("mean_sign", Some(o.mean_sign)),
                 ("reduction_pct", o.reduction_pct),
             ])
         }
@@ -148,12 +163,12 @@ fn evaluate(
                 frequency: i.get("f")?,
                 shape_exponent: i.get_or("alpha", 1.0)?,
             })?;
-            Outputs::from([
+            defined([
                 ("zeta", o.velocity_ratio),
-                ("x_a", o.vibration_amplitude),
-                ("kxa", o.stiffness_amplitude_product),
-                ("F_novib", o.friction_without_vibration),
-                ("F_avg", o.average_friction),
+                ("x_a", Some(o.vibration_amplitude)),
+                ("kxa", Some(o.stiffness_amplitude_product)),
+                ("F_novib", Some(o.friction_without_vibration)),
+                ("F_avg", Some(o.average_friction)),
                 ("ratio", o.friction_ratio),
                 ("reduction_pct", o.reduction_pct),
             ])
@@ -170,8 +185,8 @@ fn evaluate(
                 window: i.get("Tw")?,
                 initial_force_ratio: i.get("f0")?,
             })?;
-            Outputs::from([
-                ("F_avg", o.average_friction),
+            defined([
+                ("F_avg", Some(o.average_friction)),
                 ("reduction_pct", o.reduction_pct),
             ])
         }

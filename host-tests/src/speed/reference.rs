@@ -45,7 +45,7 @@ pub fn ratio(scene: &Scene<'_>, level: Fidelity, at: &GridPoint) -> Result<f64, 
     match level {
         Fidelity::Coulomb => {
             let zeta = velocity_ratio(v, vibration_velocity).map_err(|e| e.to_string())?;
-            Ok(littmann_ratio(zeta).abs())
+            Ok(zeta.map_or(1.0, |zeta| littmann_ratio(zeta).abs()))
         }
         Fidelity::DahlSteady => {
             let k_t = spec.k_t_n_per_m.ok_or("no k_t in the controller spec")?;
@@ -58,8 +58,9 @@ pub fn ratio(scene: &Scene<'_>, level: Fidelity, at: &GridPoint) -> Result<f64, 
                 frequency,
                 shape_exponent: spec.dahl_alpha.unwrap_or(1.0),
             })
-            .map(|out| out.friction_ratio)
-            .map_err(|e| e.to_string())
+            .map_err(|e| e.to_string())?
+            .friction_ratio
+            .ok_or_else(|| "no sliding (v = 0): the friction ratio is undefined".into())
         }
         Fidelity::CubeElastic | Fidelity::CubeElasticPlastic => {
             let horn = scene.horn.ok_or("no horn")?;
