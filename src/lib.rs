@@ -18,6 +18,7 @@ pub mod resonance;
 pub mod scene;
 pub mod selfcheck;
 pub mod sense;
+pub mod settings;
 pub mod sim;
 pub mod station;
 pub mod variant;
