@@ -98,6 +98,9 @@ pub enum Invalid {
     Freq,
     /// A log entry that is not a known event or fault code, or counts that disagree.
     LogEntry,
+    /// The record passed its checks but the board could not apply it (its scene or
+    /// calibration could not be built).
+    Refused,
 }
 
 impl Invalid {
@@ -117,6 +120,7 @@ impl Invalid {
             Invalid::Target => "target-out-of-range",
             Invalid::Freq => "freq-out-of-range",
             Invalid::LogEntry => "bad-log-entry",
+            Invalid::Refused => "refused-by-board",
         }
     }
 }
