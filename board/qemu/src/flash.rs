@@ -63,11 +63,32 @@ pub fn operations() -> u32 {
     OPERATIONS.load(Ordering::Relaxed)
 }
 
+/// A flash operation, for the power-cut log.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, defmt::Format)]
+enum Operation {
+    /// Programming one double word.
+    Program,
+    /// Erasing one page.
+    Erase,
+}
+
 /// Counts one operation; cuts the power first when the budget is spent.
-fn operation() {
+fn operation(kind: Operation, address: usize) {
     if POWER_CUT.load(Ordering::Relaxed) == 0 {
-        defmt::warn!("power cut before flash operation {=u32}", operations() + 1);
+        defmt::warn!(
+            "power cut before flash operation {=u32}: {} at {=usize:#06x}",
+            operations() + 1,
+            kind,
+            address
+        );
         exit::exit(exit::POWER_CUT);
+    }
+    if kind == Operation::Erase {
+        defmt::info!(
+            "flash operation {=u32}: page erase at {=usize:#06x}",
+            operations() + 1,
+            address
+        );
     }
     let _ = POWER_CUT.fetch_update(Ordering::Relaxed, Ordering::Relaxed, |left| {
         if left == u32::MAX {
@@ -193,7 +214,7 @@ impl NorFlash for FileFlash {
         }
         let erased = [0xFFu8; PAGE];
         for page in (from..to).step_by(PAGE) {
-            operation();
+            operation(Operation::Erase, page);
             self.put(page, &erased)?;
         }
         Ok(())
@@ -211,7 +232,7 @@ impl NorFlash for FileFlash {
             if old != [0xFF; WORD] {
                 return Err(FlashError::NotErased);
             }
-            operation();
+            operation(Operation::Program, address);
             self.put(address, word)?;
         }
         Ok(())
