@@ -25,12 +25,14 @@ use semihosting::sys::arm_compat::{
 
 use crate::exit;
 
+use sonolube::settings::G474_SINGLE_BANK as G474;
+
 /// Erase page, bytes (the G474's in single-bank mode).
-pub const PAGE: usize = 4096;
+pub const PAGE: usize = G474.page as usize;
 /// Programming unit, bytes (a G474 double word).
-pub const WORD: usize = 8;
-/// Pages of the emulated flash (the G474 reserves as many, see its `settings_flash.rs`).
-pub const PAGES: usize = 4;
+pub const WORD: usize = G474.word as usize;
+/// Pages of the emulated flash (as many as the G474 gives its store).
+pub const PAGES: usize = G474.store_pages as usize;
 /// Bytes of the emulated flash.
 pub const SIZE: usize = PAGE * PAGES;
 /// Longest path of the flash file, bytes.
