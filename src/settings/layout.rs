@@ -78,17 +78,16 @@ mod tests {
 
     #[test]
     fn the_store_is_whole_pages_at_the_end_and_fits_the_library() {
-        for layout in [G474_SINGLE_BANK] {
-            let range = layout.store_offsets();
-            assert_eq!(range.start % layout.page, 0);
-            assert_eq!(range.end, layout.size);
-            // sequential-storage needs at least two pages.
-            assert!(layout.store_pages >= 2);
-            // The library's largest word is 32 bytes; ours must divide the page.
-            assert!(layout.word <= 32 && layout.page % layout.word == 0);
-            // 128 pages of 4 KiB in single-bank mode.
-            assert_eq!(layout.size / layout.page, 128);
-        }
+        let layout = G474_SINGLE_BANK;
+        let range = layout.store_offsets();
+        assert!(range.start.is_multiple_of(layout.page));
+        assert_eq!(range.end, layout.size);
+        // sequential-storage needs at least two pages.
+        assert!(layout.store_pages >= 2);
+        // The library's largest word is 32 bytes; ours must divide the page.
+        assert!(layout.word <= 32 && layout.page.is_multiple_of(layout.word));
+        // 128 pages of 4 KiB in single-bank mode.
+        assert_eq!(layout.size / layout.page, 128);
     }
 
     #[test]

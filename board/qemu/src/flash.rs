@@ -211,7 +211,7 @@ impl NorFlash for FileFlash {
         if from > to || to > SIZE {
             return Err(FlashError::OutOfBounds);
         }
-        if from % PAGE != 0 || to % PAGE != 0 {
+        if !from.is_multiple_of(PAGE) || !to.is_multiple_of(PAGE) {
             return Err(FlashError::NotAligned);
         }
         let erased = [0xFFu8; PAGE];
@@ -224,7 +224,7 @@ impl NorFlash for FileFlash {
 
     async fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), FlashError> {
         let at = span(offset, bytes.len())?;
-        if at % WORD != 0 || bytes.len() % WORD != 0 {
+        if !at.is_multiple_of(WORD) || !bytes.len().is_multiple_of(WORD) {
             return Err(FlashError::NotAligned);
         }
         for (i, word) in bytes.chunks_exact(WORD).enumerate() {
