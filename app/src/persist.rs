@@ -159,6 +159,10 @@ impl<L: ControlLoop + Persistent, F: NorFlash> Persisted<L, F> {
                     self.log.boots
                 );
             }
+            Source::Defaults(_) if self.store.is_none() => defmt::info!(
+                "settings: no settings flash on this run: the scene's defaults (boot {=u32})",
+                self.log.boots
+            ),
             Source::Defaults(why) => defmt::warn!(
                 "settings: defaults, because {=str} (boot {=u32})",
                 why.reason(),
