@@ -221,3 +221,48 @@ fn a_power_cut_at_any_byte_of_a_save_leaves_the_old_or_the_new_settings() {
     assert!(kept_old > 0 && got_new > 0);
     assert!(with_erase > 0);
 }
+
+/// What `save` captures from a station is what `load` puts back: a record applied to a fresh
+/// station of its scene captures as the same record; a record the station refuses changes
+/// nothing.
+#[test]
+fn capture_returns_what_apply_put_in_and_a_refused_apply_changes_nothing() {
+    use crate::protocol::SceneName;
+    use crate::station::Station;
+    let scene = crate::scene::builtin::find("reference").expect("built in");
+    let mut station = Station::for_scene(scene).expect("builds");
+    let fresh = capture(&station, "reference", 0);
+    assert_eq!(fresh.target, None);
+    let record = Record {
+        scene: SceneName::new("reference"),
+        normal: Some(AxisCal {
+            offset_q31: 12_345,
+            span_q16: 7 << 16,
+        }),
+        tangential: Some(AxisCal {
+            offset_q31: -1 << 30,
+            span_q16: -(3 << 16),
+        }),
+        cal_count: 0,
+        target: Some(Target::Coef { coef_ppm: 200_000 }),
+        freq_chz: Some(4_100_000),
+    };
+    apply(&mut station, &record).expect("applies");
+    assert_eq!(capture(&station, "reference", 0), record);
+    assert_eq!(station.drive_freq_chz(), 4_100_000);
+
+    // A frequency outside the range (a record that skipped its checks): refused whole.
+    let mut bad = record;
+    bad.normal = Some(AxisCal {
+        offset_q31: 1,
+        span_q16: 1,
+    });
+    bad.freq_chz = Some(7_000_000);
+    assert!(apply(&mut station, &bad).is_err());
+    assert_eq!(capture(&station, "reference", 0), record);
+
+    // The defaults leave a fresh station as it is.
+    let mut other = Station::for_scene(scene).expect("builds");
+    apply(&mut other, &Record::DEFAULTS).expect("applies");
+    assert_eq!(capture(&other, "reference", 0), fresh);
+}
