@@ -16,5 +16,6 @@ pub mod resonance;
 pub mod scene;
 pub mod selfcheck;
 pub mod sense;
+pub mod settings;
 pub mod station;
 pub mod variant;

@@ -318,6 +318,12 @@ impl Station {
         &mut self.controller
     }
 
+    /// The two cells' calibrations (normal, tangential), for the settings store
+    /// ([`crate::settings::capture`]).
+    pub fn calibrations(&self) -> (crate::sense::Calibration, crate::sense::Calibration) {
+        (self.normal.calibration(), self.tangential.calibration())
+    }
+
     /// The two channels (normal, tangential), for commissioning.
     pub fn channels_mut(&mut self) -> (&mut SensorChannel, &mut SensorChannel) {
         (&mut self.normal, &mut self.tangential)

@@ -140,6 +140,10 @@ async fn execute(command: &Command, identity: &Identity, out: &mut String<LINE_C
         _ => {
             REQUESTS.send(*command).await;
             match RESPONSES.receive().await {
+                Ok(()) if crate::persist::has_reply(command) => {
+                    crate::persist::take_reply(out);
+                    return !out.is_empty();
+                }
                 Ok(()) => format_ack(command, view),
                 Err(error) => format_error(&error, view),
             }

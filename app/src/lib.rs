@@ -20,6 +20,7 @@ pub mod console;
 pub mod control;
 pub mod heartbeat;
 pub mod link;
+pub mod persist;
 pub mod snapshot;
 pub mod supervisor;
 

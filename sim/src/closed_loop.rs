@@ -336,6 +336,11 @@ impl<'a> ClosedLoop<'a> {
         &self.station
     }
 
+    /// The control side, to put stored settings into it ([`crate::settings::apply`]).
+    pub fn station_mut(&mut self) -> &mut Station {
+        &mut self.station
+    }
+
     /// The controller (its configuration and state).
     pub fn controller(&self) -> &Controller {
         self.station.controller()

@@ -46,11 +46,15 @@ pub enum ErrorCode {
     NoTarget = 23,
     /// 24 `cal-failed`: the calibration could not be completed.
     CalFailed = 24,
+    /// 25 `storage-failed`: the settings flash could not be read or written.
+    StorageFailed = 25,
+    /// 26 `settings-invalid`: nothing is stored, or the stored settings fail their checks.
+    SettingsInvalid = 26,
 }
 
 impl ErrorCode {
     /// Every code, in numeric order.
-    pub const ALL: [ErrorCode; 18] = [
+    pub const ALL: [ErrorCode; 20] = [
         ErrorCode::UnknownCommand,
         ErrorCode::BadNumber,
         ErrorCode::TrailingGarbage,
@@ -69,9 +73,11 @@ impl ErrorCode {
         ErrorCode::FaultLatched,
         ErrorCode::NoTarget,
         ErrorCode::CalFailed,
+        ErrorCode::StorageFailed,
+        ErrorCode::SettingsInvalid,
     ];
 
-    /// The number on the wire, `1..=24`.
+    /// The number on the wire, `1..=26`.
     pub const fn code(self) -> u16 {
         self as u16
     }
@@ -97,6 +103,8 @@ impl ErrorCode {
             ErrorCode::FaultLatched => "fault-latched",
             ErrorCode::NoTarget => "no-target",
             ErrorCode::CalFailed => "cal-failed",
+            ErrorCode::StorageFailed => "storage-failed",
+            ErrorCode::SettingsInvalid => "settings-invalid",
         }
     }
 
@@ -131,6 +139,8 @@ mod tests {
             (22, "fault-latched"),
             (23, "no-target"),
             (24, "cal-failed"),
+            (25, "storage-failed"),
+            (26, "settings-invalid"),
         ];
         assert_eq!(ErrorCode::ALL.len(), expected.len());
         for (code, (number, name)) in ErrorCode::ALL.into_iter().zip(expected) {

@@ -87,12 +87,22 @@ pub enum Command {
     },
     /// `telemetry off`: stop telemetry.
     TelemetryOff,
+    /// `save`: store the loop's settings (calibrations, scene, target, drive frequency) in
+    /// flash, where the next boot finds them.
+    Save,
+    /// `load`: apply the stored settings (checked: version, CRC, ranges).
+    Load,
+    /// `defaults`: apply the defaults (the scene's datasheet calibration and drive frequency,
+    /// no target); the flash is unchanged until `save`.
+    Defaults,
+    /// `log`: the boot and fault log.
+    Log,
     /// `help`: the list of commands.
     Help,
 }
 
 /// The keywords, in the order `help` lists them.
-pub const KEYWORDS: [&str; 13] = [
+pub const KEYWORDS: [&str; 17] = [
     "version",
     "status",
     "faults",
@@ -105,6 +115,10 @@ pub const KEYWORDS: [&str; 13] = [
     "cal",
     "clear",
     "telemetry",
+    "save",
+    "load",
+    "defaults",
+    "log",
     "help",
 ];
 
@@ -124,6 +138,10 @@ impl Command {
             Command::Cal { .. } => "cal",
             Command::Clear => "clear",
             Command::Telemetry { .. } | Command::TelemetryOff => "telemetry",
+            Command::Save => "save",
+            Command::Load => "load",
+            Command::Defaults => "defaults",
+            Command::Log => "log",
             Command::Help => "help",
         }
     }
@@ -178,6 +196,10 @@ pub fn format_command(command: &Command, out: &mut StringView) -> Result<(), For
             | Command::Start
             | Command::Stop
             | Command::Clear
+            | Command::Save
+            | Command::Load
+            | Command::Defaults
+            | Command::Log
             | Command::Help => {}
         }
         put(out, "\n")
@@ -234,6 +256,10 @@ pub(crate) mod tests {
                 rate_hz: u16::try_from(rate).unwrap_or(1)
             }),
             Just(Command::TelemetryOff),
+            Just(Command::Save),
+            Just(Command::Load),
+            Just(Command::Defaults),
+            Just(Command::Log),
             Just(Command::Help),
         ]
     }
@@ -279,6 +305,10 @@ pub(crate) mod tests {
             (Command::TelemetryOff, "telemetry off\n"),
             (Command::SceneList, "scene list\n"),
             (Command::Help, "help\n"),
+            (Command::Save, "save\n"),
+            (Command::Load, "load\n"),
+            (Command::Defaults, "defaults\n"),
+            (Command::Log, "log\n"),
         ];
         for (command, text) in cases {
             assert_eq!(canonical(&command), text);

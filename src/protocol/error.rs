@@ -170,6 +170,19 @@ pub enum ProtocolError {
         /// [`MAX_REASON_LEN`] bytes are shown.
         reason: &'static str,
     },
+    /// The settings flash could not be read or written (returned by the firmware).
+    StorageFailed {
+        /// What failed, one word (for example `flash-error`); at most [`MAX_REASON_LEN`]
+        /// bytes are shown.
+        reason: &'static str,
+    },
+    /// `load` found nothing stored, or stored settings that fail their checks (returned by
+    /// the firmware).
+    SettingsInvalid {
+        /// Why, one word (for example `crc-mismatch`); at most [`MAX_REASON_LEN`] bytes are
+        /// shown.
+        reason: &'static str,
+    },
 }
 
 impl ProtocolError {
@@ -194,6 +207,8 @@ impl ProtocolError {
             ProtocolError::FaultLatched { .. } => ErrorCode::FaultLatched,
             ProtocolError::NoTarget => ErrorCode::NoTarget,
             ProtocolError::CalFailed { .. } => ErrorCode::CalFailed,
+            ProtocolError::StorageFailed { .. } => ErrorCode::StorageFailed,
+            ProtocolError::SettingsInvalid { .. } => ErrorCode::SettingsInvalid,
         }
     }
 
@@ -303,6 +318,14 @@ impl ProtocolError {
             ProtocolError::NoTarget => put(out, "no target set; send target first"),
             ProtocolError::CalFailed { reason } => {
                 put(out, "calibration failed: ")?;
+                put_sanitized(out, reason, MAX_REASON_LEN)
+            }
+            ProtocolError::StorageFailed { reason } => {
+                put(out, "flash: ")?;
+                put_sanitized(out, reason, MAX_REASON_LEN)
+            }
+            ProtocolError::SettingsInvalid { reason } => {
+                put(out, "stored settings: ")?;
                 put_sanitized(out, reason, MAX_REASON_LEN)
             }
         }

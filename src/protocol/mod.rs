@@ -52,7 +52,11 @@
 //! | `clear` | | clear the latched fault | `ok` |
 //! | `telemetry <Hz>` | `1 <= rate <= 10000` hertz, 1 Hz | send telemetry at this rate | `ok telemetry_hz=100` |
 //! | `telemetry off` | | stop telemetry | `ok telemetry_hz=off` |
-//! | `help` | | list the commands | `ok commands=version,status,faults,target,scene,start,stop,freq,tare,cal,clear,telemetry,help` |
+//! | `save` | | drive off: store the calibrations, scene, target and drive frequency in flash (see [`crate::settings`]) | `ok settings=saved scene=reference cal_count=2 normal_offset_q31=-1234 normal_span_q16=6553600 tangential_offset_q31=0 tangential_span_q16=3276800 target=coef:0.150000 freq_hz=40000.00` |
+//! | `load` | | drive off: apply the stored settings, checked (version, CRC, ranges) | `ok settings=loaded ...` (the same fields) |
+//! | `defaults` | | drive off: the scene's datasheet calibration and drive frequency, no target; flash unchanged until `save` | `ok settings=defaults scene=reference cal_count=0 normal_offset_q31=none ...` |
+//! | `log` | | boots, watchdog resets, where this boot's settings came from, the last 8 faults and resets | `ok boots=3 watchdog_resets=1 boot_settings=defaults boot_reason=crc-mismatch events=watchdog-reset,overcurrent` |
+//! | `help` | | list the commands | `ok commands=version,status,faults,target,scene,start,stop,freq,tare,cal,clear,telemetry,save,load,defaults,log,help` |
 //!
 //! Numbers are `[+-]digits[.digits]`: at least one digit before a `.` and one after it, no
 //! exponent, no unit, at most 12 digits in all. A value is never rounded: a non-zero digit
@@ -96,8 +100,16 @@
 //! | 22 | `fault-latched` | a fault is latched; send `clear` first |
 //! | 23 | `no-target` | `start` without a target |
 //! | 24 | `cal-failed` | the calibration could not be completed |
+//! | 25 | `storage-failed` | the settings flash could not be read or written (`save`, `load`) |
+//! | 26 | `settings-invalid` | `load`: nothing stored, or the stored settings fail a check (the reason word says which) |
 //!
-//! Codes 1 to 13 come from this module; codes 20 to 24 are for the firmware to return when a
+//! In the `save`, `load` and `defaults` replies a field at `none` is the scene's own (its
+//! datasheet calibration, its drive frequency, no target); offsets and spans are the exact
+//! fixed-point values: `*_offset_q31` the zero reading as a Q1.31 fraction of the converter's
+//! full scale, `*_span_q16` the newtons of one full scale in Q16.16. `cal_count` counts the
+//! successful `tare` and `cal` commands since the defaults.
+//!
+//! Codes 1 to 13 come from this module; codes 20 to 26 are for the firmware to return when a
 //! well-formed command cannot be executed. A code never changes meaning; new codes get new
 //! numbers.
 //!

@@ -96,6 +96,10 @@ pub fn parse_command(line: &str) -> Result<Command, ProtocolError> {
                 (Command::Telemetry { rate_hz }, USAGE_TELEMETRY)
             }
         },
+        "save" => (Command::Save, "save"),
+        "load" => (Command::Load, "load"),
+        "defaults" => (Command::Defaults, "defaults"),
+        "log" => (Command::Log, "log"),
         "help" => (Command::Help, "help"),
         other => {
             return Err(ProtocolError::UnknownCommand {
@@ -278,6 +282,10 @@ mod tests {
             ("telemetry 100", Command::Telemetry { rate_hz: 100 }),
             ("telemetry off", Command::TelemetryOff),
             ("help", Command::Help),
+            ("save", Command::Save),
+            ("load", Command::Load),
+            ("defaults", Command::Defaults),
+            ("log", Command::Log),
         ];
         for (line, command) in cases {
             assert_eq!(parse_command(line), Ok(command), "{line:?}");
@@ -324,6 +332,9 @@ mod tests {
             ("telemetry", ErrorCode::MissingArgument),
             ("start now", ErrorCode::ExtraArgument),
             ("status status", ErrorCode::ExtraArgument),
+            ("save now", ErrorCode::ExtraArgument),
+            ("log all", ErrorCode::ExtraArgument),
+            ("Save", ErrorCode::UnknownCommand),
             ("target force 1 2", ErrorCode::ExtraArgument),
             ("scene list all", ErrorCode::ExtraArgument),
             ("freq auto 40000", ErrorCode::ExtraArgument),

@@ -152,7 +152,11 @@ pub fn format_ack(command: &Command, out: &mut StringView) -> Result<(), FormatE
         | Command::SceneList
         | Command::Start
         | Command::Stop
-        | Command::Clear => reply,
+        | Command::Clear
+        | Command::Save
+        | Command::Load
+        | Command::Defaults
+        | Command::Log => reply,
     }
     .finish()
 }
@@ -266,6 +270,12 @@ mod tests {
             },
             ProtocolError::NoTarget,
             ProtocolError::CalFailed {
+                reason: long_reason,
+            },
+            ProtocolError::StorageFailed {
+                reason: long_reason,
+            },
+            ProtocolError::SettingsInvalid {
                 reason: long_reason,
             },
         ];

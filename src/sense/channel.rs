@@ -73,6 +73,12 @@ impl SensorChannel {
         mean(readings).ok_or(SenseError::InvalidFormat)
     }
 
+    /// Replaces the calibration (a stored one, see [`crate::settings`]); the fault history is
+    /// kept.
+    pub fn set_calibration(&mut self, calibration: Calibration) {
+        self.calibration = calibration;
+    }
+
     /// The calibration in use.
     pub const fn calibration(&self) -> Calibration {
         self.calibration

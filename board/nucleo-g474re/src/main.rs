@@ -33,6 +33,7 @@ mod rig;
 mod safe;
 mod sense_task;
 mod sensing;
+mod settings_flash;
 
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, SendSpawner, Spawner};
@@ -143,12 +144,13 @@ async fn supervisor_task(
     spawner: Spawner,
     control_spawner: SendSpawner,
     watchdog: IndependentWatchdog<'static, IWDG>,
+    settings: Settings,
 ) {
     if !heartbeat::self_check::<NucleoG474re>().await {
         NucleoG474re::finish(false);
     }
     SELF_CHECK_PASSED.signal(());
-    match (control_task(), watchdog_task(watchdog)) {
+    match (control_task(settings), watchdog_task(watchdog)) {
         (Ok(control), Ok(watchdog)) => {
             control_spawner.spawn(control);
             spawner.spawn(watchdog);
@@ -160,9 +162,16 @@ async fn supervisor_task(
     }
 }
 
-/// The control loop on the default scene, from the first load-cell pair on.
+/// The settings store and the reset cause, read at boot.
+struct Settings {
+    store: Option<sonolube::settings::Store<settings_flash::SettingsFlash>>,
+    after_watchdog_reset: bool,
+}
+
+/// The control loop on the default scene (then the stored settings, `settings_flash.rs`),
+/// from the first load-cell pair on.
 #[embassy_executor::task]
-async fn control_task() {
+async fn control_task(settings: Settings) {
     let first = cells::first().await;
     let rig = match sonolube::scene::builtin::find(DEFAULT_SCENE) {
         Some(scene) => BoardRig::new(scene, first).map_err(|refusal| (scene.name, refusal)),
@@ -171,7 +180,7 @@ async fn control_task() {
             return;
         }
     };
-    let mut rig = match rig {
+    let rig = match rig {
         Ok(rig) => rig,
         Err((name, refusal)) => {
             // The drive stays safe; the watchdog (started without steps) resets the board.
@@ -179,7 +188,25 @@ async fn control_task() {
             return;
         }
     };
-    let scene = rig.scene();
+    let Settings {
+        mut store,
+        after_watchdog_reset,
+    } = settings;
+    let booted = match store.as_mut() {
+        Some(store) => Some(
+            sonolube::settings::boot(store, after_watchdog_reset, settings_flash::known_scene)
+                .await,
+        ),
+        None => None,
+    };
+    let mut rig = sonolube_app::persist::Persisted::new(
+        rig,
+        store,
+        booted,
+        after_watchdog_reset,
+        settings_flash::known_scene,
+    );
+    let scene = rig.inner().scene();
     defmt::info!(
         "control: scene {=str} at {=f64} Hz, drive {=f64} Hz, idle; cycles in {=u64} Hz",
         scene.name,
@@ -187,7 +214,7 @@ async fn control_task() {
         scene.transducer.drive_hz,
         BoardRig::CYCLE_HZ
     );
-    rig.log_model();
+    rig.inner().log_model();
     let stats = control::run(&mut rig, |_| Injection::None).await;
     // The board's loop has no end of job; should it end, the drive goes safe.
     safe::drive_safe();
@@ -247,6 +274,10 @@ async fn main(spawner: Spawner) {
     core.DWT.enable_cycle_counter();
     // Configured now, started by the watchdog task with the control loop.
     let watchdog = IndependentWatchdog::new(p.IWDG, WATCHDOG_TIMEOUT_US);
+    let settings = Settings {
+        after_watchdog_reset: settings_flash::after_watchdog_reset(),
+        store: settings_flash::open(p.FLASH),
+    };
 
     static SCENE_NAMES: StaticCell<[&'static str; MAX_SCENES]> = StaticCell::new();
     let slots = SCENE_NAMES.init([""; MAX_SCENES]);
@@ -295,7 +326,7 @@ async fn main(spawner: Spawner) {
     });
     match (
         heartbeat_task(),
-        supervisor_task(spawner, sense_spawner, watchdog),
+        supervisor_task(spawner, sense_spawner, watchdog, settings),
         console_task(rx, tx, identity),
         drive_and_sense,
         ext_adc,

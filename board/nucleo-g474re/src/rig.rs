@@ -140,6 +140,16 @@ impl BoardRig {
         self.setup.scene
     }
 
+    /// The station, for the settings store (`settings_flash.rs`).
+    pub fn station(&self) -> &Station {
+        &self.setup.station
+    }
+
+    /// The station, to put stored calibrations into (`settings_flash.rs`).
+    pub fn station_mut(&mut self) -> &mut Station {
+        &mut self.setup.station
+    }
+
     /// Logs the model variant the controller runs and why ([`sonolube::variant::select`]), at
     /// scene start.
     pub fn log_model(&self) {

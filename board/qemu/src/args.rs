@@ -5,7 +5,11 @@
 //! - `serve`: operate the scene's plant from the console (the command interface on UART0) and
 //!   run until stopped, instead of playing the scene's script and exiting with its verdict;
 //! - `icount=N`: the `-icount shift` QEMU runs with (the runner adds it), so instruction
-//!   counts and the CPU load can be printed in instructions as well as in time.
+//!   counts and the CPU load can be printed in instructions as well as in time;
+//! - `flash=PATH`: keep the settings in the host file PATH (the emulated flash, `flash.rs`;
+//!   created erased when missing); without it there is no settings flash;
+//! - `cut=N`: cut the power (exit at once, status 4) just before the N+1-th flash word
+//!   program or page erase of this run, for the power-cut test.
 
 use core::mem::MaybeUninit;
 
@@ -23,6 +27,10 @@ pub struct Args {
     pub serve: bool,
     /// QEMU's `-icount shift`, if given.
     pub icount_shift: Option<u8>,
+    /// The settings flash file, if any.
+    pub flash: Option<&'static str>,
+    /// Flash operations before the power is cut, if asked.
+    pub cut: Option<u32>,
 }
 
 /// Reads and parses the arguments; an unknown word is an error naming it.
@@ -44,6 +52,8 @@ fn parse(text: &'static str) -> Result<Args, &'static str> {
         scene: DEFAULT_SCENE,
         serve: false,
         icount_shift: None,
+        flash: None,
+        cut: None,
     };
     // The first word is the kernel's file name.
     for word in text.split_ascii_whitespace().skip(1) {
@@ -51,6 +61,13 @@ fn parse(text: &'static str) -> Result<Args, &'static str> {
             args.serve = true;
         } else if let Some(name) = word.strip_prefix("scene=") {
             args.scene = name;
+        } else if let Some(path) = word.strip_prefix("flash=") {
+            if path.is_empty() || path.len() > crate::flash::MAX_PATH {
+                return Err("flash= takes a path of 1 to 200 bytes");
+            }
+            args.flash = Some(path);
+        } else if let Some(n) = word.strip_prefix("cut=") {
+            args.cut = Some(n.parse::<u32>().map_err(|_| "cut= takes a count")?);
         } else if let Some(shift) = word.strip_prefix("icount=") {
             args.icount_shift = Some(
                 shift

@@ -15,6 +15,8 @@ pub const SELFCHECK_FAILED: i32 = 1;
 pub const WATCHDOG_RESET: i32 = 2;
 /// Exit status after a HardFault or an unexpected exception.
 pub const FAULT: i32 = 3;
+/// Exit status of a run whose power was cut on purpose (`cut=N`, see `flash.rs`).
+pub const POWER_CUT: i32 = 4;
 /// Exit status after a panic (the same number a panicking Rust program uses on a host).
 pub const PANIC: i32 = 101;
 

@@ -8,7 +8,8 @@
 //!
 //! What runs is chosen by QEMU's `-append` words (`args.rs`): by default the `reference`
 //! scene's script, judged, then exit; `scene=NAME` another scene; `serve` the console drives
-//! the plant and the run goes on until QEMU is stopped.
+//! the plant and the run goes on until QEMU is stopped; `flash=FILE` keeps the settings (`save`,
+//! `load`, `defaults`, `log`) in that host file (`flash.rs`), loaded and checked at boot.
 //!
 //! Test builds (cargo features) fail on purpose, so that the test command can check each
 //! failure is reported: `fail-selfcheck` stalls the heartbeat once (the self-check must fail),
@@ -25,6 +26,7 @@ mod bench;
 mod drive;
 mod executor;
 mod exit;
+mod flash;
 mod irq;
 mod report;
 mod rig;
@@ -35,14 +37,40 @@ mod watchdog;
 use defmt_semihosting as _;
 use embassy_executor::{SendSpawner, raw};
 use embassy_time::{Duration, Instant};
+use sonolube::settings::{Source, boot};
 use sonolube_app::console::Identity;
 use sonolube_app::control::Injection;
+use sonolube_app::persist::Persisted;
 use sonolube_app::{Board, console, control, heartbeat, supervisor};
 use sonolube_sim::Mode;
 use static_cell::StaticCell;
 
 use crate::args::Args;
+use crate::flash::FileFlash;
 use crate::rig::SimulatedRig;
+
+/// The control loop: the simulated rig with its settings store.
+type Rig = Persisted<SimulatedRig, FileFlash>;
+
+fn known_scene(name: &str) -> bool {
+    sonolube::scene::builtin::find(name).is_some()
+}
+
+/// The settings store of the run (`flash=FILE`), with the power cut armed (`cut=N`); `None`
+/// without a flash file. A file that cannot be opened ends the run.
+fn settings_store(args: &Args) -> Option<sonolube::settings::Store<FileFlash>> {
+    let path = args.flash?;
+    if let Some(n) = args.cut {
+        flash::cut_power_after(n);
+    }
+    match flash::open_store(path) {
+        Ok(store) => Some(store),
+        Err(error) => {
+            defmt::error!("settings flash {=str} cannot be opened: {}", path, error);
+            exit::exit(exit::SELFCHECK_FAILED);
+        }
+    }
+}
 
 defmt::timestamp!("{=u64:us}", Instant::now().as_micros());
 
@@ -124,22 +152,34 @@ async fn supervisor_task(args: Args, control_spawner: SendSpawner) {
     if cfg!(feature = "bench") {
         Qemu::finish(bench::run());
     }
-    let Some(scene) = sonolube::scene::builtin::find(args.scene) else {
+    let Some(home) = sonolube::scene::builtin::find(args.scene) else {
         defmt::error!("no scene named {=str}", args.scene);
         exit::exit(exit::SELFCHECK_FAILED);
     };
+    // The settings first: a stored scene is the one the loop is built for.
+    let mut store = settings_store(&args);
+    let booted = store
+        .as_mut()
+        .map(|store| embassy_futures::block_on(boot(store, false, known_scene)));
+    let scene = booted
+        .as_ref()
+        .filter(|booted| booted.source == Source::Stored && args.serve)
+        .and_then(|booted| booted.record.scene)
+        .and_then(|name| sonolube::scene::builtin::find(name.as_str()))
+        .unwrap_or(home);
     let mode = if args.serve {
         Mode::Operated
     } else {
         Mode::Scripted
     };
     let rig = match time_driver::exclude(|| SimulatedRig::new(scene, mode)) {
-        Ok(rig) => rig,
+        Ok(rig) => rig.with_home(home),
         Err(error) => {
             defmt::error!("scene {=str} cannot run: {}", scene.name, error);
             exit::exit(exit::SELFCHECK_FAILED);
         }
     };
+    let rig = Persisted::new(rig, store, booted, false, known_scene);
     match control_task(rig, args) {
         Ok(token) => {
             control_spawner.spawn(token);
@@ -152,8 +192,8 @@ async fn supervisor_task(args: Args, control_spawner: SendSpawner) {
 }
 
 #[embassy_executor::task]
-async fn control_task(mut rig: SimulatedRig, args: Args) {
-    let scene = rig.scene();
+async fn control_task(mut rig: Rig, args: Args) {
+    let scene = rig.inner().scene();
     if args.serve {
         defmt::info!(
             "serving the console on UART0: scene {=str} at {=f64} Hz, idle",
@@ -168,7 +208,7 @@ async fn control_task(mut rig: SimulatedRig, args: Args) {
             scene.control_rate_hz
         );
     }
-    rig.log_model();
+    rig.inner().log_model();
     let steps = scene.step_count();
     let start = (
         time_driver::cycles(),
@@ -187,7 +227,7 @@ async fn control_task(mut rig: SimulatedRig, args: Args) {
         args.icount_shift,
     );
     report::plant(&stats, plant, args.icount_shift);
-    let passed = report::verdicts(scene.name, &rig.summary());
+    let passed = report::verdicts(scene.name, &rig.inner().summary());
     Qemu::finish(passed)
 }
 
@@ -209,8 +249,24 @@ fn main() -> ! {
         exit::exit(exit::FAULT);
     };
     time_driver::init(core.SYST);
+    let args = match args::read() {
+        Ok(args) => args,
+        Err(reason) => {
+            defmt::error!("bad arguments: {=str}", reason);
+            exit::exit(exit::SELFCHECK_FAILED);
+        }
+    };
     if watchdog::take_reset_mark() {
         defmt::error!("the previous run ended in a watchdog reset");
+        if let Some(mut store) = settings_store(&args) {
+            let booted =
+                embassy_futures::block_on(sonolube::settings::boot(&mut store, true, known_scene));
+            defmt::info!(
+                "settings log: boot {=u32}, {=u32} watchdog resets",
+                booted.log.boots,
+                booted.log.watchdog_resets
+            );
+        }
         exit::exit(exit::WATCHDOG_RESET);
     }
     if !cfg!(feature = "hang") {
@@ -222,13 +278,6 @@ fn main() -> ! {
         Qemu::NAME,
         time_driver::CORE_CLOCK_HZ
     );
-    let args = match args::read() {
-        Ok(args) => args,
-        Err(reason) => {
-            defmt::error!("bad arguments: {=str}", reason);
-            exit::exit(exit::SELFCHECK_FAILED);
-        }
-    };
     static SCENE_NAMES: StaticCell<heapless::Vec<&'static str, MAX_SCENES>> = StaticCell::new();
     let names = SCENE_NAMES.init(
         sonolube::scene::builtin::SCENES

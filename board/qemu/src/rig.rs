@@ -9,10 +9,12 @@
 //! This is [`sonolube_sim::ClosedLoop`], the same code as `sonolube scene` on the host, with
 //! the plant reading the board's drive output instead of the controller's command directly.
 
-use sonolube::control::ExternalFault;
-use sonolube::protocol::{Command, ProtocolError, SceneName};
+use sonolube::control::{ExternalFault, Reason};
+use sonolube::protocol::{Command, ProtocolError, SceneName, SupervisorState};
 use sonolube::scene::Scene;
+use sonolube::settings::Record;
 use sonolube_app::control::ControlLoop;
+use sonolube_app::persist::Persistent;
 use sonolube_app::snapshot::Snapshot;
 use sonolube_sim::{ClosedLoop, Mode, RunSummary, SimError};
 
@@ -20,8 +22,13 @@ use crate::{drive, time_driver};
 
 /// The simulated rig running one scene.
 pub struct SimulatedRig {
+    /// The scene the run was started with: the one the settings' defaults use.
+    home: &'static Scene<'static>,
     scene: &'static Scene<'static>,
     run: ClosedLoop<'static>,
+    /// No command has changed the loop since it was built: settings for its scene go straight
+    /// into it, without building another.
+    pristine: bool,
 }
 
 impl SimulatedRig {
@@ -32,7 +39,18 @@ impl SimulatedRig {
             Mode::Scripted => ClosedLoop::new(scene)?,
             Mode::Operated => ClosedLoop::operated(scene)?,
         };
-        Ok(Self { scene, run })
+        Ok(Self {
+            home: scene,
+            scene,
+            run,
+            pristine: true,
+        })
+    }
+
+    /// The same rig, with `home` as the scene the settings' defaults use.
+    pub fn with_home(mut self, home: &'static Scene<'static>) -> Self {
+        self.home = home;
+        self
     }
 
     /// The scene.
@@ -81,6 +99,7 @@ impl SimulatedRig {
             Ok(run) => {
                 self.scene = scene;
                 self.run = run;
+                self.pristine = true;
                 self.log_model();
                 Ok(())
             }
@@ -89,6 +108,65 @@ impl SimulatedRig {
                 Err(unknown)
             }
         }
+    }
+}
+
+/// The settings store's view of the rig (`sonolube_app::persist`).
+impl Persistent for SimulatedRig {
+    fn capture(&self) -> Record {
+        sonolube::settings::capture(self.run.station(), self.scene.name, 0)
+    }
+
+    /// A new loop for the record's scene (the run's own scene when it has none) with the
+    /// record's calibrations, drive frequency and target; swapped in only when all applied.
+    fn apply(&mut self, record: &Record) -> Result<(), ProtocolError> {
+        if self.run.mode() != Mode::Operated {
+            return Err(ProtocolError::WrongState {
+                command: "load",
+                state: self.run.controller().state(),
+            });
+        }
+        let scene = match record.scene {
+            Some(name) => sonolube::scene::builtin::find(name.as_str())
+                .ok_or(ProtocolError::UnknownScene { name })?,
+            None => self.home,
+        };
+        if self.pristine && core::ptr::eq(scene, self.scene) {
+            // The boot's case: the loop was just built for this scene. Building another would
+            // need a second loop on the stack next to this one.
+            time_driver::exclude(|| sonolube::settings::apply(self.run.station_mut(), record))?;
+            self.pristine = false;
+            return Ok(());
+        }
+        // Building a loop takes a large part of the watchdog timeout in QEMU's virtual time
+        // (the plant's tables): the watchdog is fed on either side (the loop is alive: this is
+        // a command, or the boot).
+        crate::watchdog::feed();
+        let built = time_driver::exclude(|| ClosedLoop::operated(scene));
+        crate::watchdog::feed();
+        let mut run = built.map_err(|error| {
+            defmt::error!("scene {=str} cannot run: {}", scene.name, error);
+            ProtocolError::SettingsInvalid {
+                reason: "scene-cannot-run",
+            }
+        })?;
+        time_driver::exclude(|| sonolube::settings::apply(run.station_mut(), record))?;
+        let changed = !core::ptr::eq(scene, self.scene);
+        self.scene = scene;
+        self.run = run;
+        self.pristine = false;
+        if changed {
+            self.log_model();
+        }
+        Ok(())
+    }
+
+    fn state(&self) -> SupervisorState {
+        self.run.controller().state()
+    }
+
+    fn latched_fault(&self) -> Option<Reason> {
+        self.run.controller().fault()
     }
 }
 
@@ -120,6 +198,7 @@ impl ControlLoop for SimulatedRig {
     }
 
     fn execute(&mut self, command: &Command) -> Result<(), ProtocolError> {
+        self.pristine = false;
         match command {
             Command::Scene(name) if self.run.mode() == Mode::Operated => {
                 self.select_scene(command, *name)

@@ -1,0 +1,103 @@
+//! The settings store on the G474's own flash: the last four 4 KiB pages
+//! ([`sonolube::settings::G474_SINGLE_BANK`], kept out of the code by `memory.x`), through
+//! embassy-stm32's blocking flash driver behind embassy-embedded-hal's `BlockingAsync` adapter
+//! (the store's futures complete on their first poll). Also the board's side of the settings
+//! ([`Persistent`] for [`BoardRig`]) and the reset cause for the boot log.
+//!
+//! The firmware is built `single-bank`: when the option bytes say dual-bank (DBANK = 1, 2 KiB
+//! pages) the store stays closed, `save` and `load` answer `storage-failed`, and the board runs
+//! with the scene's defaults (embassy's driver would panic on the mismatch).
+
+use embassy_embedded_hal::adapter::BlockingAsync;
+use embassy_stm32::Peri;
+use embassy_stm32::flash::{Blocking, Flash};
+use embassy_stm32::peripherals::FLASH;
+use sonolube::control::Reason;
+use sonolube::fx::{Q1_31, Q16_16};
+use sonolube::protocol::{Command, ProtocolError, SceneName, SupervisorState};
+use sonolube::sense::Calibration;
+use sonolube::settings::{G474_SINGLE_BANK, Record, Store};
+use sonolube_app::control::ControlLoop;
+use sonolube_app::persist::Persistent;
+
+use crate::rig::BoardRig;
+
+/// The flash as the store sees it.
+pub type SettingsFlash = BlockingAsync<Flash<'static, Blocking>>;
+
+/// The store on the last pages, or `None` (logged) when the flash is in dual-bank mode.
+pub fn open(flash: Peri<'static, FLASH>) -> Option<Store<SettingsFlash>> {
+    if embassy_stm32::pac::FLASH.optr().read().dbank() {
+        defmt::error!(
+            "settings: the flash is in dual-bank mode (option bit DBANK); this build expects single-bank 4 KiB pages: no settings store"
+        );
+        return None;
+    }
+    let driver = BlockingAsync::new(Flash::new_blocking(flash));
+    match Store::new(driver, G474_SINGLE_BANK.store_offsets()) {
+        Ok(store) => Some(store),
+        Err(error) => {
+            defmt::error!("settings: store refused its range: {}", error);
+            None
+        }
+    }
+}
+
+/// Whether the last reset came from a watchdog (IWDG or WWDG), read from RCC_CSR; clears
+/// the reset flags (RMVF) so that the next reset is told apart.
+pub fn after_watchdog_reset() -> bool {
+    let rcc = embassy_stm32::pac::RCC;
+    let csr = rcc.csr().read();
+    rcc.csr().modify(|w| w.set_rmvf(true));
+    csr.iwdgrstf() || csr.wwdgrstf()
+}
+
+/// Whether this firmware has a scene of this name.
+pub fn known_scene(name: &str) -> bool {
+    sonolube::scene::builtin::find(name).is_some()
+}
+
+impl Persistent for BoardRig {
+    fn capture(&self) -> Record {
+        sonolube::settings::capture(self.station(), self.scene().name, 0)
+    }
+
+    /// The record's scene (the default scene when it has none) is selected afresh, which
+    /// restores the scene's own calibration, drive frequency and no target; then the record's
+    /// calibrations go into the cells, its frequency to the station and TIM1, its target to
+    /// the controller. The record's values passed their range checks, so the last two are
+    /// not refused (a refusal is returned, with the scene already switched).
+    fn apply(&mut self, record: &Record) -> Result<(), ProtocolError> {
+        let name = match record.scene {
+            Some(name) => name,
+            None => SceneName::new(crate::DEFAULT_SCENE).ok_or(ProtocolError::SettingsInvalid {
+                reason: "no-default-scene",
+            })?,
+        };
+        self.execute(&Command::Scene(name))?;
+        let (normal, tangential) = self.station_mut().channels_mut();
+        for (channel, cal) in [(normal, record.normal), (tangential, record.tangential)] {
+            if let Some(cal) = cal {
+                channel.set_calibration(Calibration::new(
+                    Q1_31::from_bits(cal.offset_q31),
+                    Q16_16::from_bits(cal.span_q16),
+                ));
+            }
+        }
+        if let Some(freq_chz) = record.freq_chz {
+            self.execute(&Command::Freq { freq_chz })?;
+        }
+        if let Some(target) = record.target {
+            self.execute(&Command::Target(target))?;
+        }
+        Ok(())
+    }
+
+    fn state(&self) -> SupervisorState {
+        self.station().state()
+    }
+
+    fn latched_fault(&self) -> Option<Reason> {
+        self.station().controller().fault()
+    }
+}

@@ -1,0 +1,294 @@
+//! The store on the library's own mock flash (`sequential_storage::mock_flash`), with the
+//! G474's geometry in single-bank mode: 4 KiB pages, 8-byte (double-word) writes, each word
+//! written once between erases.
+
+use core::ops::Range;
+
+use sequential_storage::mock_flash::{MockFlashBase, WriteCountCheck};
+
+use super::record::tests::{known, sample};
+use super::*;
+use crate::control::Reason;
+use crate::protocol::Target;
+
+/// Four 4 KiB pages of 8-byte words.
+type Flash = MockFlashBase<4, 8, 512>;
+const RANGE: Range<u32> = 0..4 * 4096;
+
+fn new_flash() -> Flash {
+    Flash::new(WriteCountCheck::OnceOnly, None, true)
+}
+
+fn run<T>(future: impl core::future::Future<Output = T>) -> T {
+    embassy_futures::block_on(future)
+}
+
+fn store(flash: Flash) -> Store<Flash> {
+    Store::new(flash, RANGE).expect("whole pages")
+}
+
+#[test]
+fn a_saved_record_is_found_by_a_new_store_on_the_same_flash() {
+    let mut s = store(new_flash());
+    assert_eq!(run(s.load(known)), Err(Invalid::Empty));
+    run(s.save(&sample(1))).unwrap();
+    run(s.save(&sample(2))).unwrap();
+    // A reset: the RAM state (the library's cache, our buffers) is gone, the flash is not.
+    let mut s = store(s.into_flash());
+    assert_eq!(run(s.load(known)), Ok(sample(2)));
+}
+
+#[test]
+fn the_range_must_be_whole_pages_and_at_least_two() {
+    assert!(matches!(
+        Store::new(new_flash(), 0..4096),
+        Err(StoreError::Config)
+    ));
+    assert!(matches!(
+        Store::new(new_flash(), 100..8192),
+        Err(StoreError::Config)
+    ));
+}
+
+#[test]
+fn boot_falls_back_to_the_defaults_and_says_why() {
+    let mut s = store(new_flash());
+    let first = run(boot(&mut s, false, known));
+    assert_eq!(first.record, Record::DEFAULTS);
+    assert_eq!(first.source, Source::Defaults(Invalid::Empty));
+    assert_eq!((first.log.boots, first.log.watchdog_resets), (1, 0));
+    assert_eq!(first.log_write, None);
+
+    // Valid CRC, but a drive frequency out of range.
+    let mut bytes = sample(1).encode();
+    bytes[56..60].copy_from_slice(&7_000_000u32.to_le_bytes());
+    let crc = crc32(&bytes[..60]);
+    bytes[60..64].copy_from_slice(&crc.to_le_bytes());
+    run(s.store(1, &bytes)).unwrap();
+    let second = run(boot(&mut s, true, known));
+    assert_eq!(second.source, Source::Defaults(Invalid::Freq));
+    assert_eq!(second.record, Record::DEFAULTS);
+    assert_eq!((second.log.boots, second.log.watchdog_resets), (2, 1));
+    assert_eq!(
+        second.log.events().collect::<Vec<_>>(),
+        [Event::WatchdogReset]
+    );
+
+    // A flipped bit under a valid item: the record's own CRC finds it.
+    let mut bytes = sample(1).encode();
+    bytes[20] ^= 4;
+    run(s.store(1, &bytes)).unwrap();
+    assert_eq!(
+        run(boot(&mut s, false, known)).source,
+        Source::Defaults(Invalid::Crc)
+    );
+
+    // Another version, a scene this firmware does not have.
+    let mut bytes = sample(1).encode();
+    bytes[4] = 9;
+    run(s.store(1, &bytes)).unwrap();
+    assert_eq!(
+        run(boot(&mut s, false, known)).source,
+        Source::Defaults(Invalid::Version(9))
+    );
+    run(s.save(&sample(1))).unwrap();
+    assert_eq!(
+        run(boot(&mut s, false, |name| name == "demo")).source,
+        Source::Defaults(Invalid::UnknownScene)
+    );
+
+    // A good record again.
+    let good = run(boot(&mut s, false, known));
+    assert_eq!((good.source, good.record), (Source::Stored, sample(1)));
+    assert_eq!(good.log.boots, 6);
+}
+
+#[test]
+fn a_bad_log_is_replaced_and_reported() {
+    let mut s = store(new_flash());
+    run(s.store(2, &[0x55; LOG_BYTES])).unwrap();
+    let boot = run(boot(&mut s, false, known));
+    assert_eq!(boot.log_invalid, Some(Invalid::Magic));
+    assert_eq!(boot.log.boots, 1);
+    assert_eq!(run(s.load_log()), Ok(boot.log));
+}
+
+#[test]
+fn faults_and_resets_survive_in_the_log() {
+    let mut s = store(new_flash());
+    let mut log = run(boot(&mut s, false, known)).log;
+    log.push(Event::Fault(Reason::Overcurrent));
+    run(s.save_log(&log)).unwrap();
+    let mut s = store(s.into_flash());
+    let after = run(boot(&mut s, true, known)).log;
+    assert_eq!(
+        after.events().collect::<Vec<_>>(),
+        [Event::Fault(Reason::Overcurrent), Event::WatchdogReset]
+    );
+    assert_eq!((after.boots, after.watchdog_resets), (2, 1));
+}
+
+/// Writes spread over every page: after many saves each page has been erased several times
+/// and none much more than the others (the item size over the page size sets the rate).
+#[test]
+fn saves_are_spread_over_all_pages() {
+    let fresh = new_flash();
+    let start = fresh.stats_snapshot();
+    let mut s = store(fresh);
+    let saves = 2_000u32;
+    for n in 0..saves {
+        run(s.save(&sample(n))).unwrap();
+    }
+    let flash = s.into_flash();
+    let erases = start.compare_to(flash.stats_snapshot()).erases;
+    // An item is 64 bytes of value, 1 of key and a header, rounded to 8-byte words: 80 bytes
+    // (`cost` below), so 51 fit a 4 KiB page and 2,000 saves fill 39 pages: about 36 erases
+    // (the first pages are blank), all four pages in turn.
+    assert!((30..=45).contains(&erases), "{erases} erases");
+    let mut s = store(flash);
+    assert_eq!(run(s.load(known)), Ok(sample(saves - 1)));
+}
+
+/// Flash operations (in bytes written or erased, the mock's unit of a power cut) of saving
+/// `record` on `flash`.
+fn cost(flash: &Flash, record: &Record) -> u32 {
+    let mut probe = flash.clone();
+    probe.bytes_until_shutoff = Some(u32::MAX);
+    let mut s = store(probe);
+    run(s.save(record)).unwrap();
+    let probe = s.into_flash();
+    u32::MAX - probe.bytes_until_shutoff.unwrap_or(u32::MAX)
+}
+
+/// The power-cut test: the store holds `old`; a save of `new` is cut after every byte it
+/// writes or erases (every one of them for most saves, 400 evenly spread for the saves that
+/// also erase a page), over 150 saves in a row so that the cuts also fall into page
+/// reclaims. After each cut a new store (a reset) must load exactly `old` or exactly `new`,
+/// never anything else, and must then save and load a third record.
+#[test]
+fn a_power_cut_at_any_byte_of_a_save_leaves_the_old_or_the_new_settings() {
+    let mut base = store(new_flash());
+    run(base.save(&sample(0))).unwrap();
+    let mut base = base.into_flash();
+    let mut old = sample(0);
+    let (mut cuts, mut kept_old, mut got_new, mut with_erase) = (0u32, 0u32, 0u32, 0u32);
+    for n in 1..=150u32 {
+        let mut new = sample(n);
+        new.target = Some(Target::Force { force_mn: n });
+        new.scene = if n % 2 == 0 { None } else { old.scene };
+        let units = cost(&base, &new);
+        let step = if units > 400 { units / 400 } else { 1 };
+        let erases_page = units > 4096;
+        for cut in (0..units).step_by(step as usize) {
+            let mut flash = base.clone();
+            flash.bytes_until_shutoff = Some(cut);
+            let mut s = store(flash);
+            assert_eq!(
+                run(s.save(&new)),
+                Err(StoreError::Flash),
+                "save {n} cut {cut}"
+            );
+            let mut flash = s.into_flash();
+            flash.bytes_until_shutoff = None;
+            let mut s = store(flash);
+            let loaded = run(s.load(known));
+            match loaded {
+                Ok(r) if r == old => kept_old += 1,
+                Ok(r) if r == new => got_new += 1,
+                other => panic!("save {n} cut at {cut} of {units}: loaded {other:?}"),
+            }
+            let third = sample(1_000 + n);
+            run(s.save(&third)).unwrap_or_else(|e| panic!("save {n} cut {cut}: {e:?}"));
+            assert_eq!(run(s.load(known)), Ok(third));
+            cuts += 1;
+            with_erase += u32::from(erases_page);
+        }
+        let mut s = store(base);
+        run(s.save(&new)).unwrap();
+        if n % 7 == 0 {
+            let mut log = Log::EMPTY;
+            log.boot(n % 14 == 0);
+            run(s.save_log(&log)).unwrap();
+        }
+        base = s.into_flash();
+        old = new;
+    }
+    println!(
+        "power cut: {cuts} cut points, {kept_old} kept the old settings, {got_new} the new, \
+         {with_erase} in saves that reclaim a page"
+    );
+    assert!(cuts > 10_000, "{cuts}");
+    assert!(kept_old > 0 && got_new > 0);
+    assert!(with_erase > 0);
+}
+
+/// What `save` captures from a station is what `load` puts back: a record applied to a fresh
+/// station of its scene captures as the same record; a record the station refuses changes
+/// nothing.
+#[test]
+fn capture_returns_what_apply_put_in_and_a_refused_apply_changes_nothing() {
+    use crate::protocol::SceneName;
+    let scene = crate::scene::builtin::find("reference").expect("built in");
+    let mut station = station_of(scene);
+    let fresh = capture(&station, "reference", 0);
+    assert_eq!(fresh.target, None);
+    let record = Record {
+        scene: SceneName::new("reference"),
+        normal: Some(AxisCal {
+            offset_q31: 12_345,
+            span_q16: 7 << 16,
+        }),
+        tangential: Some(AxisCal {
+            offset_q31: -1 << 30,
+            span_q16: -(3 << 16),
+        }),
+        cal_count: 0,
+        target: Some(Target::Coef { coef_ppm: 200_000 }),
+        freq_chz: Some(4_100_000),
+    };
+    apply(&mut station, &record).expect("applies");
+    assert_eq!(capture(&station, "reference", 0), record);
+    assert_eq!(station.drive_freq_chz(), 4_100_000);
+
+    // A frequency outside the range (a record that skipped its checks): refused whole.
+    let mut bad = record;
+    bad.normal = Some(AxisCal {
+        offset_q31: 1,
+        span_q16: 1,
+    });
+    bad.freq_chz = Some(7_000_000);
+    assert!(apply(&mut station, &bad).is_err());
+    assert_eq!(capture(&station, "reference", 0), record);
+
+    // The defaults leave a fresh station as it is.
+    let mut other = station_of(scene);
+    apply(&mut other, &Record::DEFAULTS).expect("applies");
+    assert_eq!(capture(&other, "reference", 0), fresh);
+}
+
+/// A station of `scene` on 12-bit unipolar channels with the nominal calibration (what the
+/// simulation's `scene_station` builds, without depending on it).
+fn station_of(scene: &crate::scene::Scene<'_>) -> crate::station::Station {
+    use crate::fx::{Q1_31, Q16_16};
+    use crate::sense::{AdcFormat, Calibration, FaultLimits, SensorChannel};
+    let channel = |cell: &crate::scene::LoadCell| {
+        let span = Q16_16::from_f64(2.0 * cell.full_scale_n).expect("span in range");
+        SensorChannel::new(
+            AdcFormat::unipolar(cell.adc_bits).expect("format"),
+            FaultLimits {
+                rail_margin: Q1_31::from_bits(1 << 19),
+                noise_band: Q1_31::ZERO,
+                stuck_samples: 0,
+                max_step: Q1_31::MAX,
+            },
+            Calibration::new(Q1_31::from_bits(1 << 30), span),
+        )
+    };
+    crate::station::Station::new(
+        scene,
+        &crate::control::controller_settings(scene),
+        channel(&scene.normal_cell),
+        channel(&scene.tangential_cell),
+    )
+    .expect("builds")
+}
