@@ -52,35 +52,17 @@ pub const RAMP_RISE_STEPS: u32 = 10;
 #[cfg(feature = "bringup")]
 pub const RAMP_FALL_STEPS: u32 = 5;
 
-/// Drive current sense: 25 mOhm shunt in the stack's return, INA240A1 (20 V/V) referenced to
-/// mid-supply, into PA1 (ADC1_IN2 and COMP1_INP). 0.5 V/A, +-3.3 A range.
-pub const CURRENT_SENSE: ShuntAmplifier = ShuntAmplifier {
-    shunt_micro_ohm: 25_000,
-    gain_milli: 20_000,
-    zero_millivolt: 1650,
-    full_scale_millivolt: 3300,
-};
+/// Stack current sense (25 mOhm, INA240A1, 0.5 V/A around 1.65 V into PA1), defined with the
+/// comparators it feeds in `sonolube_g474_hw::protect` (host-tested thresholds).
+pub const CURRENT_SENSE: ShuntAmplifier = sonolube_g474_hw::protect::STACK_SENSE;
 
-/// Overcurrent trip: 2.5 A, 1.43 times the stack's 1.75 A rating (seed 003 Table 1), leaving
-/// room for the motional current at resonance that the capacitance model does not include.
-/// Both half-waves: COMP1 above +2.5 A, COMP3 below -2.5 A (`overcurrent.rs`).
-pub const TRIP_CURRENT: Q16_16 = Q16_16::from_ratio_const(5, 2);
-
-/// DC-link current sense: 10 mOhm shunt between the half-bridge's ground (the low-side
-/// MOSFET's source and the stack-return shunt's ground end) and the bus capacitor's negative
-/// terminal, INA240A1 (20 V/V) referenced to mid-supply, into PB11 (COMP6_INP). 0.2 V/A,
-/// +-8.25 A range. Carries the stack current during the high-side phase, and every
-/// shoot-through or switch-node short.
-pub const DC_LINK_SENSE: ShuntAmplifier = ShuntAmplifier {
-    shunt_micro_ohm: 10_000,
-    gain_milli: 20_000,
-    zero_millivolt: 1650,
-    full_scale_millivolt: 3300,
-};
-
-/// DC-link trip: 6 A, above the 2.5 A stack trip (the DC link carries the stack current in the
-/// high-side phase) and far below a shoot-through's current.
-pub const DC_LINK_TRIP_CURRENT: Q16_16 = Q16_16::from_ratio_const(6, 1);
+/// Stack overcurrent trip (2.5 A, both half-waves), DC-link sense (10 mOhm, 0.2 V/A into PB11)
+/// and DC-link trip (6 A): `sonolube_g474_hw::protect`, where their DAC codes are tested.
+pub const TRIP_CURRENT: Q16_16 = sonolube_g474_hw::protect::STACK_TRIP_CURRENT;
+/// See [`TRIP_CURRENT`].
+pub const DC_LINK_SENSE: ShuntAmplifier = sonolube_g474_hw::protect::DC_LINK_SENSE;
+/// See [`TRIP_CURRENT`].
+pub const DC_LINK_TRIP_CURRENT: Q16_16 = sonolube_g474_hw::protect::DC_LINK_TRIP_CURRENT;
 
 /// Load cells on the internal ADC: 50 lbf (222 N) cells like seed 003's MPL-50-T, 2 mV/V at
 /// 5 V excitation, INA826 at gain 150 (RG = 332 Ohm) referenced to 1.65 V.

@@ -14,6 +14,9 @@
 //! COMP6 INP IO1 = PB11; INMSEL 100 = DAC3_CH1 for COMP1, 101 = DAC1_CH1 for COMP3,
 //! 100 = DAC4_CH2 for COMP6). The DACs run in internal mode (no pin), buffer off.
 
+use sonolube::fx::Q16_16;
+use sonolube::sense::ShuntAmplifier;
+
 use crate::Step;
 use crate::pac::comp::Comp;
 use crate::pac::comp::regs::Csr;
@@ -26,6 +29,37 @@ use crate::pac::gpio::vals::{Moder, Pupdr};
 use crate::pac::rcc::Rcc;
 use crate::pac::syscfg::Syscfg;
 use crate::pac::syscfg::regs::Cfgr2;
+
+/// Stack current sense: 25 mOhm shunt in the stack's return, INA240A1 (20 V/V) referenced to
+/// mid-supply, into PA1 (ADC1_IN2, COMP1_INP) and, by a jumper, PC1 (COMP3_INP). 0.5 V/A,
+/// +-3.3 A range.
+pub const STACK_SENSE: ShuntAmplifier = ShuntAmplifier {
+    shunt_micro_ohm: 25_000,
+    gain_milli: 20_000,
+    zero_millivolt: 1650,
+    full_scale_millivolt: 3300,
+};
+
+/// Stack overcurrent trip: 2.5 A, 1.43 times the stack's 1.75 A rating (seed 003 Table 1),
+/// leaving room for the motional current at resonance. Both half-waves: COMP1 above +2.5 A,
+/// COMP3 below -2.5 A.
+pub const STACK_TRIP_CURRENT: Q16_16 = Q16_16::from_ratio_const(5, 2);
+
+/// DC-link current sense: 10 mOhm shunt between the half-bridge's ground (the low-side
+/// MOSFET's source and the stack-return shunt's ground end) and the bus capacitor's negative
+/// terminal, INA240A1 (20 V/V) referenced to mid-supply, into PB11 (COMP6_INP). 0.2 V/A,
+/// +-8.25 A range. It carries the stack current during the high-side phase, and every
+/// shoot-through or switch-node short.
+pub const DC_LINK_SENSE: ShuntAmplifier = ShuntAmplifier {
+    shunt_micro_ohm: 10_000,
+    gain_milli: 20_000,
+    zero_millivolt: 1650,
+    full_scale_millivolt: 3300,
+};
+
+/// DC-link trip: 6 A, above the 2.5 A stack trip (the DC link carries the stack current in the
+/// high-side phase) and far below a shoot-through's current.
+pub const DC_LINK_TRIP_CURRENT: Q16_16 = Q16_16::from_ratio_const(6, 1);
 
 /// One comparator's input selection and output polarity.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -269,6 +303,42 @@ mod tests {
         assert_eq!(window_low_code(0, 100), None);
         assert_eq!(window_low_code(-5, 100), None);
         assert_eq!(window_low_code(1 << 30, 2048), None);
+    }
+
+    /// A DAC code as the current it stands for on `sense`, mA.
+    fn code_ma(code: u16, sense: &ShuntAmplifier) -> i64 {
+        let reading = sonolube::fx::Q1_31::from_bits(i32::from(code) << 19);
+        let amps = sense.calibration().unwrap().apply(reading).value;
+        i64::from(amps.to_bits()) * 1000 / 65_536
+    }
+
+    #[test]
+    fn the_boards_thresholds() {
+        use sonolube::drive::OvercurrentTrip;
+        let stack = STACK_SENSE.calibration().unwrap();
+        let high = OvercurrentTrip::new(STACK_TRIP_CURRENT, &stack)
+            .unwrap()
+            .dac_code();
+        let low = window_low_code(stack.offset().to_bits(), high).unwrap();
+        let dc = OvercurrentTrip::new(DC_LINK_TRIP_CURRENT, &DC_LINK_SENSE.calibration().unwrap())
+            .unwrap()
+            .dac_code();
+        let mv = |code: u16| u32::from(code) * 3300 / 4096;
+        std::eprintln!(
+            "thresholds: COMP1 DAC3 {high} ({} mV, {} mA), COMP3 DAC1 {low} ({} mV, {} mA), \
+             COMP6 DAC4 {dc} ({} mV, {} mA)",
+            mv(high),
+            code_ma(high, &STACK_SENSE),
+            mv(low),
+            code_ma(low, &STACK_SENSE),
+            mv(dc),
+            code_ma(dc, &DC_LINK_SENSE)
+        );
+        assert_eq!((high, low, dc), (3599, 497, 3537));
+        // Never later than asked: |trip| at most the requested current.
+        assert!((2490..=2500).contains(&code_ma(high, &STACK_SENSE)));
+        assert!((-2500..=-2490).contains(&code_ma(low, &STACK_SENSE)));
+        assert!((5980..=6000).contains(&code_ma(dc, &DC_LINK_SENSE)));
     }
 
     #[test]
