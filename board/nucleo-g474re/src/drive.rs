@@ -59,7 +59,7 @@ impl Drive {
 pub fn write_timing(timing: &DriveTiming, amplitude: Amplitude) {
     if let Err(refused) = tim1::write_timing(pac::TIM1, timing, amplitude, &mut |_| {}) {
         safe::drive_safe();
-        defmt::error!("TIM1 timing refused: {}", defmt::Debug2Format(&refused));
+        defmt::error!("TIM1 timing refused: {}", refused);
     }
 }
 

@@ -58,10 +58,7 @@ pub async fn run(hw: Hardware) {
     let _drive = match drive::Drive::new(hw.tim1, hw.high_side, hw.low_side, &timing) {
         Ok(drive) => drive,
         Err(refused) => {
-            defmt::error!(
-                "TIM1 configuration refused ({}); drive stays off",
-                defmt::Debug2Format(&refused)
-            );
+            defmt::error!("TIM1 configuration refused ({}); drive stays off", refused);
             return;
         }
     };
@@ -110,10 +107,7 @@ pub async fn run(hw: Hardware) {
     ) {
         Ok(ring) => ring,
         Err(error) => {
-            defmt::error!(
-                "ADC1 sampling did not start ({}); drive stays off",
-                defmt::Debug2Format(&error)
-            );
+            defmt::error!("ADC1 sampling did not start ({}); drive stays off", error);
             return;
         }
     };

@@ -41,7 +41,7 @@ static RING: StaticCell<[u16; RING_LEN]> = StaticCell::new();
 pub type Block = [u16; CHANNELS * SCANS_PER_READ];
 
 /// Why sampling did not start.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, defmt::Format)]
 pub enum StartError {
     /// The ADC was converting when the plan was written (nothing written).
     AdcRunning,

@@ -59,6 +59,7 @@ pub const fn pair_code(first: u16, second: u16) -> Option<u16> {
 /// Refused: a regular conversion is running (CFGR, SMPR and SQR are written only with
 /// ADSTART = 0, RM0440).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct AdcRunning;
 
 /// Writes the plan: CFGR (DMA circular, 12 bits right-aligned, TIM1_TRGO2 rising edge, single
@@ -107,6 +108,7 @@ pub fn program_regular(adc: Adc, hook: &mut impl FnMut(Step)) -> Result<(), AdcR
 
 /// What [`check_dma_ring`] found wrong in the DMA channel the ADC ring runs on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum DmaProblem {
     /// Not enabled.
     Disabled,

@@ -55,6 +55,7 @@ impl Pll {
 
 /// The outcome of [`start_hse`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum HseStart {
     /// HSERDY rose after this many polls.
     Ready { polls: u32 },

@@ -39,9 +39,11 @@ const CCMR2_CH4: usize = 1;
 /// BRK and BRK2 in the BDTR break field arrays.
 const BRK: usize = 0;
 const BRK2: usize = 1;
-/// COMP1 is index 0 of TIM1_AF1.BKCMPxE; COMP3 is index 2 of TIM1_AF2.BK2CMPxE.
+/// COMP1 is index 0 of TIM1_AF1.BKCMPxE; COMP3 and COMP6 are indices 2 and 5 of
+/// TIM1_AF2.BK2CMPxE.
 pub const BRK_COMP1: usize = 0;
 pub const BRK2_COMP3: usize = 2;
+pub const BRK2_COMP6: usize = 5;
 
 /// Break and break 2 filter: 6 samples at f_DTS / 8 (282 ns at 170 MHz). Rejects the
 /// comparators' response to switching spikes shorter than that.
@@ -68,6 +70,7 @@ pub const TIM1_AF: u8 = 6;
 
 /// Why a TIM1 write was refused. Nothing was written when one is returned.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Refused {
     /// MOE is set: the dead time and the break setup are written only with the outputs off.
     OutputsOn,
@@ -146,8 +149,8 @@ pub fn configure(
     ccmr2.set_ocpe(CCMR2_CH4, true);
     tim.ccmr_output(1).write_value(ccmr2);
     hook("TIM1_CCMR2");
-    // Break sources: COMP1 only on BRK, COMP3 only on BRK2; the BKIN pins off (their reset
-    // value is on).
+    // Break sources: COMP1 only on BRK, COMP3 and COMP6 only on BRK2; the BKIN pins off (their
+    // reset value is on). (BKCMPxP exists for COMP1-4 only; COMP6's polarity is its own.)
     let mut af1 = Af1Adv(0);
     af1.set_bkine(false);
     af1.set_bkcmpe(BRK_COMP1, true);
@@ -158,6 +161,7 @@ pub fn configure(
     af2.set_bk2ine(false);
     af2.set_bk2cmpe(BRK2_COMP3, true);
     af2.set_bk2cmpp(BRK2_COMP3, Bkinp::NOT_INVERTED);
+    af2.set_bk2cmpe(BRK2_COMP6, true);
     tim.af2().write_value(af2);
     hook("TIM1_AF2");
     tim.bdtr().write_value(bdtr_value(timing.dead_time()));

@@ -104,7 +104,11 @@ fn configure_writes_the_reference_manuals_fields() {
     assert_eq!(image.bits(AF1, 1, 7), 0b000_0001, "BKCMP1E only");
     assert!(!image.bit(AF1, 10), "BKCMP1P");
     assert!(!image.bit(AF2, 0), "BK2INE");
-    assert_eq!(image.bits(AF2, 1, 7), 0b000_0100, "BK2CMP3E only");
+    assert_eq!(
+        image.bits(AF2, 1, 7),
+        0b010_0100,
+        "BK2CMP3E and BK2CMP6E only"
+    );
     assert!(!image.bit(AF2, 12), "BK2CMP3P");
     // Period registers and the update event that loaded them.
     assert_eq!(image.word(ARR), t.period().arr_register());
@@ -214,7 +218,7 @@ fn configure_order_moe_stays_off_and_bdtr_is_written_once() {
         if i == bdtr_at {
             assert_eq!(word(snap, CR2) & (0b11 << 8), 0, "OIS1/OIS1N");
             assert_ne!(word(snap, AF1) & 0b10, 0, "BKCMP1E");
-            assert_ne!(word(snap, AF2) & 0b1000, 0, "BK2CMP3E");
+            assert_eq!(word(snap, AF2) & 0xFE, 0b0100_1000, "BK2CMP3E, BK2CMP6E");
         }
     }
     // DITHEN changed only while the counter was stopped.
