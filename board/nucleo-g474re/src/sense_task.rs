@@ -151,12 +151,8 @@ pub async fn run(hw: Hardware) {
     let mut next_log = Instant::now() + LOG_PERIOD;
     loop {
         match ring.read(&mut block).await {
-            Ok(_) => {
-                let Some(triplet) = sensing::combine(&block) else {
-                    malformed = malformed.saturating_add(1);
-                    continue;
-                };
-                {
+            Ok(_) => match sensing::combine(&block) {
+                Some(triplet) => {
                     for (i, &code) in triplet.iter().enumerate() {
                         let fault = logs[i].record(&mut channels[i], i32::from(code));
                         // A saturated or disconnected current sense stops the drive at once and
@@ -172,7 +168,14 @@ pub async fn run(hw: Hardware) {
                     let [normal, tangential, _] = triplet;
                     cells::publish(RawPair { normal, tangential });
                 }
-            }
+                None => {
+                    // A result wider than 12 bits: the ADC is not in the plan. The current is
+                    // then unknown: the drive goes safe, as for a faulty current sample.
+                    malformed = malformed.saturating_add(1);
+                    drive::set_current_sense_healthy(false);
+                    safe::drive_safe();
+                }
+            },
             Err(_) => overruns = overruns.saturating_add(1),
         }
         #[cfg(feature = "bringup")]
