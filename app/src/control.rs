@@ -111,14 +111,19 @@ pub async fn run<L: ControlLoop>(
         let sample_at = tick_at;
         let deadline = tick_at + period;
         if Instant::now() >= deadline {
-            defmt::warn!(
-                "control overrun: woke {=u64} us after its tick, step ended {=u64} us after the deadline, control part {=u32} cycles",
-                (woke - tick_at.min(woke)).as_micros(),
-                (Instant::now() - deadline).as_micros(),
-                snapshot.control_cycles
-            );
             link::bump(&OVERRUNS);
             stats.overruns = stats.overruns.saturating_add(1);
+            // Rate-limited: the 1st, 2nd, 4th, 8th ... overrun is logged, with the total, so a
+            // loop that overruns steadily cannot flood the log (and stall on it).
+            if stats.overruns.is_power_of_two() {
+                defmt::warn!(
+                    "control overrun {=u32}: woke {=u64} us after its tick, step ended {=u64} us after the deadline, control part {=u32} cycles",
+                    stats.overruns,
+                    (woke - tick_at.min(woke)).as_micros(),
+                    (Instant::now() - deadline).as_micros(),
+                    snapshot.control_cycles
+                );
+            }
             in_a_row += 1;
             if in_a_row == OVERRUN_FAULT_RUN {
                 defmt::error!("{=u32} control overruns in a row: overrun fault", in_a_row);

@@ -9,7 +9,8 @@ use sonolube::ext_adc::{Config as AdsConfig, Gain, Osr, clkin_divider};
 use sonolube::fx::{Q1_31, Q16_16};
 use sonolube::sense::{AdcFormat, BridgeAmplifier, FaultLimits, Oversampling, ShuntAmplifier};
 
-/// TIM1 counts the 170 MHz system clock (main.rs clock tree, APB2 undivided).
+/// TIM1 counts the 170 MHz system clock (main.rs clock tree: 24 MHz HSE, or HSI16 as the
+/// fallback, through the PLL; APB2 undivided).
 pub const TIMER_CLOCK: TimerClock = TimerClock::G474_TIM1;
 
 /// Drive frequency at start: 40 kHz, the half-wave mode seed 003 drives the stack in.
@@ -51,18 +52,17 @@ pub const RAMP_RISE_STEPS: u32 = 10;
 #[cfg(feature = "bringup")]
 pub const RAMP_FALL_STEPS: u32 = 5;
 
-/// Drive current sense: 25 mOhm shunt in the stack's return, INA240A1 (20 V/V) referenced to
-/// mid-supply, into PA1 (ADC1_IN2 and COMP1_INP). 0.5 V/A, +-3.3 A range.
-pub const CURRENT_SENSE: ShuntAmplifier = ShuntAmplifier {
-    shunt_micro_ohm: 25_000,
-    gain_milli: 20_000,
-    zero_millivolt: 1650,
-    full_scale_millivolt: 3300,
-};
+/// Stack current sense (25 mOhm, INA240A1, 0.5 V/A around 1.65 V into PA1), defined with the
+/// comparators it feeds in `sonolube_g474_hw::protect` (host-tested thresholds).
+pub const CURRENT_SENSE: ShuntAmplifier = sonolube_g474_hw::protect::STACK_SENSE;
 
-/// Overcurrent trip: 2.5 A, 1.43 times the stack's 1.75 A rating (seed 003 Table 1), leaving
-/// room for the motional current at resonance that the capacitance model does not include.
-pub const TRIP_CURRENT: Q16_16 = Q16_16::from_ratio_const(5, 2);
+/// Stack overcurrent trip (2.5 A, both half-waves), DC-link sense (10 mOhm, 0.2 V/A into PB11)
+/// and DC-link trip (6 A): `sonolube_g474_hw::protect`, where their DAC codes are tested.
+pub const TRIP_CURRENT: Q16_16 = sonolube_g474_hw::protect::STACK_TRIP_CURRENT;
+/// See [`TRIP_CURRENT`].
+pub const DC_LINK_SENSE: ShuntAmplifier = sonolube_g474_hw::protect::DC_LINK_SENSE;
+/// See [`TRIP_CURRENT`].
+pub const DC_LINK_TRIP_CURRENT: Q16_16 = sonolube_g474_hw::protect::DC_LINK_TRIP_CURRENT;
 
 /// Load cells on the internal ADC: 50 lbf (222 N) cells like seed 003's MPL-50-T, 2 mV/V at
 /// 5 V excitation, INA826 at gain 150 (RG = 332 Ohm) referenced to 1.65 V.
@@ -83,7 +83,10 @@ pub const LOAD_CELL_EXTERNAL: BridgeAmplifier = BridgeAmplifier {
     ..LOAD_CELL_INTERNAL
 };
 
-/// Internal ADC: 12 bits, 16x hardware oversampling, no shift: 16-bit results (0 to 65 520).
+/// The 16-bit format of the internal ADC's codes (0 to 65 520): that of 16 summed 12-bit
+/// results. The plan converts without hardware oversampling and sums two scans, times 8
+/// (`sonolube_g474_hw::adc::pair_code`), so the codes keep the format the sensing chain and
+/// [`crate::cells`] expect, with steps of 8.
 pub const OVERSAMPLING: Oversampling = match Oversampling::new(4, 0) {
     Ok(oversampling) => oversampling,
     Err(_) => panic!("oversampling setting invalid"),
@@ -97,29 +100,26 @@ pub const ADC_FORMAT: AdcFormat = match AdcFormat::oversampled(12, OVERSAMPLING)
 
 /// ADC clock: SYSCLK / 4 = 42.5 MHz (embassy picks the prescaler to stay under 60 MHz).
 pub const ADC_CLOCK_HZ: u32 = 42_500_000;
-/// One conversion: 47.5 cycles sampling (low-impedance amplifier outputs) + 12.5 conversion.
-pub const ADC_CONVERSION_CYCLES_X2: u32 = 120;
-/// One conversion in nanoseconds (1412 ns).
-pub const ADC_CONVERSION_NS: u32 =
-    (ADC_CONVERSION_CYCLES_X2 as u64 * 1_000_000_000 / 2 / ADC_CLOCK_HZ as u64) as u32;
+/// One scan of the three channels (24.5 + 12.5 cycles each), ns: 2612.
+pub const ADC_SCAN_NS: u32 = sonolube_g474_hw::adc::scan_ns(ADC_CLOCK_HZ);
 
-// Each trigger starts one conversion (triggered oversampling), which must end before the next
-// switching edge at every frequency of the band; the quiet window is shortest at 60 kHz.
+// Each trigger starts one scan, which must end before the next switching edge at every
+// frequency of the band; the quiet window is shortest at 60 kHz.
 const _: () = {
     let fastest = match DriveTiming::new(Frequency::BAND_MAX, DEAD_TIME_NS, TIMER_CLOCK) {
         Ok(timing) => timing,
         Err(_) => panic!("dead time too long for 60 kHz"),
     };
-    assert!(ADC_CONVERSION_NS < fastest.quiet_window_ns());
+    assert!(ADC_SCAN_NS < fastest.quiet_window_ns());
 };
 
-/// Fault limits of the load-cell channels: rail within 0.2 % of full scale; stuck if 2000
-/// samples (2.4 s at 40 kHz / 48 triggers per triplet) stay within 1 LSB; a jump of more than
-/// 1/8 of full scale between samples 1.2 ms apart is no force.
+/// Fault limits of the load-cell channels: rail within 0.2 % of full scale; stuck if 48 000
+/// triplets (2.4 s at 40 kHz / 2 triggers per triplet) stay within 1 LSB of the 16-bit
+/// format; a jump of more than 1/8 of full scale between triplets 50 us apart is no force.
 pub const LOAD_CELL_LIMITS: FaultLimits = FaultLimits {
     rail_margin: Q1_31::from_bits(1 << 22),
     noise_band: Q1_31::from_bits(1 << 15),
-    stuck_samples: 2000,
+    stuck_samples: 48_000,
     max_step: Q1_31::from_bits(1 << 28),
 };
 

@@ -1,8 +1,15 @@
 //! Sonolube firmware for the NUCLEO-G474RE (STM32G474RE, Cortex-M4F at 170 MHz).
 //!
-//! Clocks: HSI16 through the PLL to 170 MHz (range-1 boost), so the board needs no crystal;
-//! ADC1/2 clocked from SYSCLK. Time driver: embassy-stm32's (`time-driver-any`: TIM15),
-//! leaving TIM1 for the drive and TIM3 for the external ADC's clock. Log: defmt over RTT.
+//! Clocks: the board's 24 MHz HSE crystal through the PLL to 170 MHz (range-1 boost), with the
+//! clock security system on; HSI16 (+-1 %) with a logged warning when the crystal does not
+//! start within 20 ms. FLASH: 4 wait states, prefetch and caches on. ADC1/2 clocked from
+//! SYSCLK. Time driver: embassy-stm32's (`time-driver-any`: TIM15), leaving TIM1 for the drive
+//! and TIM3 for the external ADC's clock. Log: defmt over RTT, never blocking.
+//!
+//! Faults: HardFault, every unexpected exception or interrupt (cortex-m-rt's
+//! `DefaultHandler`, which includes the NMI of a crystal failure) and a panic make the drive
+//! safe before anything else: MOE cleared, PA8/PB13 driven low as GPIO outputs. A core lockup
+//! breaks TIM1 in hardware (SYSCFG_CFGR2), and a debug halt stops TIM1 with its outputs off.
 //!
 //! Boot: the self-check (heartbeat and supervisor tasks, thread executor) runs first, with the
 //! drive pins untouched. When it passes, the supervisor signals the drive-and-sense task, which
@@ -40,15 +47,16 @@ use embassy_executor::{InterruptExecutor, SendSpawner, Spawner};
 use embassy_stm32::interrupt;
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::peripherals::IWDG;
+use embassy_stm32::time::Hertz;
 use embassy_stm32::usart::{BufferedUartRx, BufferedUartTx};
-use embassy_stm32::wdg::IndependentWatchdog;
-use embassy_stm32::{bind_interrupts, comp, dma, peripherals, rcc, usart};
+use embassy_stm32::{Peri, bind_interrupts, dma, pac, peripherals, rcc, usart};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Timer};
 use sonolube_app::console::Identity;
 use sonolube_app::control::{ControlLoop, Injection};
 use sonolube_app::{Board, control, heartbeat, link, supervisor};
+use sonolube_g474_hw::{clock, iwdg};
 use static_cell::StaticCell;
 
 use crate::rig::BoardRig;
@@ -56,7 +64,6 @@ use crate::rig::BoardRig;
 // Every interrupt handler the firmware binds, in one place.
 bind_interrupts!(pub struct Irqs {
     DMA1_CHANNEL1 => dma::InterruptHandler<peripherals::DMA1_CH1>;
-    COMP1_2_3 => comp::InterruptHandler<peripherals::COMP1>;
     USART2 => usart::BufferedInterruptHandler<peripherals::USART2>;
 });
 
@@ -83,6 +90,15 @@ const DEFAULT_SCENE: &str = "reference";
 
 /// Watchdog (IWDG, on the 32 kHz LSI) timeout: 500 periods of the `reference` loop.
 const WATCHDOG_TIMEOUT_US: u32 = 50_000;
+/// Its prescaler and reload (/4, 400 ticks), checked at compile time.
+const WATCHDOG: iwdg::Setting = match iwdg::Setting::for_timeout_us(WATCHDOG_TIMEOUT_US) {
+    Some(setting) => setting,
+    None => panic!("watchdog timeout out of range"),
+};
+/// Polls of the IWDG's update flags (a few LSI cycles: well under 1000 polls).
+const WATCHDOG_SETTLE_POLLS: u32 = 10_000;
+/// The crystal gets this many 1 us polls to start (datasheet: 2 ms typical).
+const HSE_START_POLLS: u32 = 20_000;
 /// The keeper looks for signs of life this often.
 const KEEPER_EVERY_MS: u64 = 5;
 /// The watchdog starts with the control loop's first step, or this long after the self-check
@@ -115,13 +131,31 @@ impl Board for NucleoG474re {
     }
 }
 
-/// Core clock: HSI16 / 4 * 85 / 2 = 170 MHz; ADC1/2 kernel clock = SYSCLK (embassy divides by
-/// 4 to 42.5 MHz, under the ADC's 60 MHz).
-fn clock_config() -> embassy_stm32::Config {
+// The PLL settings below are the ones `sonolube_g474_hw::clock` checks (170 MHz, VCO limits).
+const _: () = assert!(clock::HSE_PLL.frequencies(clock::HSE_HZ).2 == clock::SYSCLK_HZ);
+const _: () = assert!(clock::HSI_PLL.frequencies(clock::HSI_HZ).2 == clock::SYSCLK_HZ);
+const _: () =
+    assert!(clock::HSE_PLL.prediv == 6 && clock::HSE_PLL.mul == 85 && clock::HSE_PLL.divr == 2);
+const _: () =
+    assert!(clock::HSI_PLL.prediv == 4 && clock::HSI_PLL.mul == 85 && clock::HSI_PLL.divr == 2);
+
+/// Core clock: HSE 24 MHz / 6 * 85 / 2 = 170 MHz when the crystal runs (`hse`), else
+/// HSI16 / 4 * 85 / 2; ADC1/2 kernel clock = SYSCLK (embassy divides by 4 to 42.5 MHz, under
+/// the ADC's 60 MHz).
+fn clock_config(hse: bool) -> embassy_stm32::Config {
     let mut config = embassy_stm32::Config::default();
+    let (source, prediv) = if hse {
+        config.rcc.hse = Some(rcc::Hse {
+            freq: Hertz(clock::HSE_HZ),
+            mode: rcc::HseMode::Oscillator,
+        });
+        (rcc::PllSource::HSE, rcc::PllPreDiv::DIV6)
+    } else {
+        (rcc::PllSource::HSI, rcc::PllPreDiv::DIV4)
+    };
     config.rcc.pll = Some(rcc::Pll {
-        source: rcc::PllSource::HSI,
-        prediv: rcc::PllPreDiv::DIV4,
+        source,
+        prediv,
         mul: rcc::PllMul::MUL85,
         divp: None,
         divq: None,
@@ -143,7 +177,7 @@ async fn heartbeat_task() {
 async fn supervisor_task(
     spawner: Spawner,
     control_spawner: SendSpawner,
-    watchdog: IndependentWatchdog<'static, IWDG>,
+    watchdog: Peri<'static, IWDG>,
     settings: Settings,
 ) {
     if !heartbeat::self_check::<NucleoG474re>().await {
@@ -232,17 +266,25 @@ async fn console_task(
 
 /// Starts the IWDG with the control loop and feeds it while the loop steps.
 #[embassy_executor::task]
-async fn watchdog_task(mut watchdog: IndependentWatchdog<'static, IWDG>) {
+async fn watchdog_task(_watchdog: Peri<'static, IWDG>) {
     let after_self_check = Instant::now();
     while link::count(&link::STEPS) == 0 && after_self_check.elapsed() < CONTROL_START_LIMIT {
         Timer::after_millis(1).await;
     }
-    watchdog.unleash();
+    let settled = iwdg::start(pac::IWDG, WATCHDOG, WATCHDOG_SETTLE_POLLS, &mut |_| {});
     defmt::info!(
-        "watchdog: {=u32} us timeout, fed while the control loop steps",
-        WATCHDOG_TIMEOUT_US
+        "watchdog: {=u32} us timeout (PR /{=u32}, RLR {=u16}), fed while the control loop steps",
+        WATCHDOG.timeout_us(iwdg::LSI_HZ),
+        4u32 << WATCHDOG.prescaler_code,
+        WATCHDOG.reload
     );
-    supervisor::keeper(Duration::from_millis(KEEPER_EVERY_MS), || watchdog.pet()).await
+    if !settled {
+        defmt::warn!("watchdog: prescaler/reload update did not complete in time");
+    }
+    supervisor::keeper(Duration::from_millis(KEEPER_EVERY_MS), || {
+        iwdg::pet(pac::IWDG)
+    })
+    .await
 }
 
 #[embassy_executor::task]
@@ -259,12 +301,36 @@ async fn ext_adc_task(hw: ext_adc::ExtAdcHardware) {
 #[embassy_executor::main]
 async fn main(spawner: Spawner) {
     NucleoG474re::drive_safe();
-    let p = embassy_stm32::init(clock_config());
+    // The crystal is started here, with a timeout: embassy's clock setup waits for it forever.
+    // At reset the core runs on HSI16: 16 cycles are 1 us.
+    let hse = clock::start_hse(
+        pac::RCC,
+        HSE_START_POLLS,
+        || cortex_m::asm::delay(16),
+        &mut |_| {},
+    );
+    let on_hse = matches!(hse, clock::HseStart::Ready { .. });
+    let p = embassy_stm32::init(clock_config(on_hse));
+    clock::configure_flash(pac::FLASH, &mut |_| {});
     defmt::info!(
         "sonolube {} on {}",
         env!("CARGO_PKG_VERSION"),
         NucleoG474re::NAME
     );
+    match hse {
+        clock::HseStart::Ready { polls } => {
+            clock::enable_css(pac::RCC, &mut |_| {});
+            defmt::info!(
+                "clock: 24 MHz HSE crystal (ready after {=u32} us) -> PLL -> 170 MHz, CSS on",
+                polls
+            );
+        }
+        clock::HseStart::TimedOut => defmt::warn!(
+            "clock: HSE crystal did not start within {=u32} us; running on HSI16 (+-1 %: the \
+             drive frequency may be off by up to 400 Hz at 40 kHz)",
+            HSE_START_POLLS
+        ),
+    }
     // The control loop times its steps with the DWT cycle counter.
     let Some(mut core) = cortex_m::Peripherals::take() else {
         defmt::error!("core peripherals already taken");
@@ -272,8 +338,8 @@ async fn main(spawner: Spawner) {
     };
     core.DCB.enable_trace();
     core.DWT.enable_cycle_counter();
-    // Configured now, started by the watchdog task with the control loop.
-    let watchdog = IndependentWatchdog::new(p.IWDG, WATCHDOG_TIMEOUT_US);
+    // Started by the watchdog task with the control loop.
+    let watchdog = p.IWDG;
     let settings = Settings {
         after_watchdog_reset: settings_flash::after_watchdog_reset(),
         store: settings_flash::open(p.FLASH),
@@ -305,8 +371,16 @@ async fn main(spawner: Spawner) {
         tim1: p.TIM1,
         high_side: p.PA8,
         low_side: p.PB13,
-        comparator: p.COMP1,
-        threshold_dac: p.DAC3,
+        protection: overcurrent::Peripherals {
+            comp1: p.COMP1,
+            comp3: p.COMP3,
+            comp6: p.COMP6,
+            dac1: p.DAC1,
+            dac3: p.DAC3,
+            dac4: p.DAC4,
+            window_input: p.PC1,
+            dc_link_input: p.PB11,
+        },
         adc: p.ADC1,
         normal_force: p.PA0,
         tangential_force: p.PB0,
@@ -339,6 +413,36 @@ async fn main(spawner: Spawner) {
             spawner.spawn(console);
         }
         _ => defmt::panic!("could not spawn the tasks"),
+    }
+}
+
+/// A HardFault makes the drive safe before anything else, then reports and waits for the
+/// watchdog (or a debugger). cortex-m-rt's default would loop with TIM1 still switching.
+#[cortex_m_rt::exception]
+unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
+    safe::drive_safe_final();
+    cortex_m::interrupt::disable();
+    defmt::error!(
+        "HardFault at pc {=u32:#010x}: drive output safe",
+        frame.pc()
+    );
+    loop {
+        cortex_m::asm::nop();
+    }
+}
+
+/// Every exception and interrupt without a handler of its own (NMI, MemManage, BusFault,
+/// UsageFault, an unbound interrupt): the drive goes safe first, as for a HardFault.
+#[cortex_m_rt::exception]
+unsafe fn DefaultHandler(irqn: i16) -> ! {
+    safe::drive_safe_final();
+    cortex_m::interrupt::disable();
+    defmt::error!(
+        "unexpected exception or interrupt {=i16}: drive output safe",
+        irqn
+    );
+    loop {
+        cortex_m::asm::nop();
     }
 }
 

@@ -1,58 +1,123 @@
-//! Hardware overcurrent shutdown: current sense on PA1 -> COMP1 (threshold from DAC3 channel 1)
-//! -> TIM1 break input -> both bridge outputs low, with no software in the path.
+//! Hardware overcurrent shutdown, three comparators into TIM1's break inputs with no software
+//! in the path (the register programming is `sonolube_g474_hw::protect`, host-tested):
 //!
-//! COMP1's non-inverting input is PA1 (COMP1_INP, RM0440 COMP chapter); its inverting input
-//! is DAC3_CH1, an internal DAC (INMSEL = 100b, embassy's `InvertingInput::Dac1` on COMP1).
-//! TIM1_AF1.BKCMP1E routes the comparator output to the break input ([`crate::drive`]). The
-//! comparator compares at high speed (tens of ns); the break filter adds 0.3 us.
+//! - COMP1: stack current above +trip. PA1 (stack-return shunt amplifier) against DAC3_CH1 ->
+//!   BRK.
+//! - COMP3: stack current below -trip. PC1, jumpered to PA1, against DAC1_CH1 (mirror of
+//!   COMP1's threshold around the tared zero), output inverted -> BRK2. With COMP1 a window:
+//!   both half-waves of the stack current trip.
+//! - COMP6: DC-link current above its trip. PB11 (DC-link shunt amplifier) against DAC4_CH2
+//!   -> BRK2. Shoot-through and a switch node shorted to ground flow here, never through the
+//!   stack-return shunt.
+//!
+//! Each comparator reacts in tens of ns; the break filter adds 0.28 us (board README).
+//! Comparators are locked (CSR read-only until reset) once armed; thresholds stay movable.
 
 use embassy_stm32::Peri;
-use embassy_stm32::comp::{self, Comp, Hysteresis, InvertingInput};
-use embassy_stm32::dac::{self, DacChannel, Value};
-use embassy_stm32::mode::Blocking;
-use embassy_stm32::peripherals::{COMP1, DAC3, PA1};
+use embassy_stm32::pac;
+use embassy_stm32::peripherals::{COMP1, COMP3, COMP6, DAC1, DAC3, DAC4, PB11, PC1};
 use sonolube::drive::OvercurrentTrip;
+use sonolube::fx::Q1_31;
+use sonolube_g474_hw::protect;
 
-use crate::Irqs;
+/// DAC channel indices.
+const CH1: usize = 0;
+const CH2: usize = 1;
+/// Stack-current input of COMP1 (PA1) and the window and DC-link inputs.
+const PA1: usize = 1;
+const PC1_PIN: usize = 1;
+const PB11_PIN: usize = 11;
 
-/// The armed comparator and its threshold DAC. Keep it alive: dropping it disarms the trip.
+/// The peripherals the guard owns: held, never used through embassy (their registers are
+/// written through the PAC), so nothing else can claim them.
+#[allow(dead_code)]
+pub struct Peripherals {
+    pub comp1: Peri<'static, COMP1>,
+    pub comp3: Peri<'static, COMP3>,
+    pub comp6: Peri<'static, COMP6>,
+    pub dac1: Peri<'static, DAC1>,
+    pub dac3: Peri<'static, DAC3>,
+    pub dac4: Peri<'static, DAC4>,
+    /// COMP3's input: jumper it to PA1.
+    pub window_input: Peri<'static, PC1>,
+    /// COMP6's input: the DC-link shunt amplifier.
+    pub dc_link_input: Peri<'static, PB11>,
+}
+
+/// The three thresholds as DAC codes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, defmt::Format)]
+pub struct Thresholds {
+    pub stack_high: u16,
+    pub stack_low: u16,
+    pub dc_link: u16,
+}
+
+impl Thresholds {
+    /// The window around `stack_zero` (the current channel's zero reading) for `stack_trip`,
+    /// and the DC-link trip. None when the mirrored lower threshold leaves the range.
+    pub fn new(
+        stack_trip: OvercurrentTrip,
+        stack_zero: Q1_31,
+        dc_link: OvercurrentTrip,
+    ) -> Option<Self> {
+        let stack_high = stack_trip.dac_code();
+        let stack_low = protect::window_low_code(stack_zero.to_bits(), stack_high)?;
+        Some(Self {
+            stack_high,
+            stack_low,
+            dc_link: dc_link.dac_code(),
+        })
+    }
+}
+
+/// The armed comparators. Keep it alive (it owns their peripherals).
 pub struct OvercurrentGuard {
-    comparator: Comp<'static, COMP1>,
-    threshold: DacChannel<'static, Blocking>,
+    _peripherals: Peripherals,
+    thresholds: Thresholds,
 }
 
 impl OvercurrentGuard {
-    /// Sets DAC3_CH1 to `trip` and enables COMP1 on PA1 against it. PA1 stays usable as the ADC
-    /// input of the same signal (the comparator only borrows it to set it analog).
-    pub fn arm(
-        comparator: Peri<'static, COMP1>,
-        sense_pin: Peri<'_, PA1>,
-        dac: Peri<'static, DAC3>,
-        trip: OvercurrentTrip,
-    ) -> Self {
-        let mut threshold = DacChannel::new_internal_blocking::<DAC3, dac::Ch1>(dac);
-        threshold.set(Value::Bit12Right(trip.dac_code()));
-        let config = comp::Config {
-            // 20 mV against chatter at the threshold (40 mA of current at 0.5 V/A).
-            hysteresis: Hysteresis::Hyst20M,
-            inverting_input: InvertingInput::Dac1,
-            ..comp::Config::default()
-        };
-        let mut comparator = Comp::new(comparator, sense_pin, Irqs, config);
-        comparator.enable();
+    /// Sets the threshold DACs, then enables and locks the three comparators.
+    pub fn arm(peripherals: Peripherals, thresholds: Thresholds) -> Self {
+        let hook = &mut |_| {};
+        protect::enable_clocks(pac::RCC, hook);
+        protect::analog_pin(pac::GPIOA, PA1, hook);
+        protect::analog_pin(pac::GPIOC, PC1_PIN, hook);
+        protect::analog_pin(pac::GPIOB, PB11_PIN, hook);
+        protect::threshold_dac(pac::DAC3, CH1, thresholds.stack_high, hook);
+        protect::threshold_dac(pac::DAC1, CH1, thresholds.stack_low, hook);
+        protect::threshold_dac(pac::DAC4, CH2, thresholds.dc_link, hook);
+        // DAC wake-up and comparator start-up: a few us (datasheet tWAKEUP, tSTART).
+        embassy_time::block_for(embassy_time::Duration::from_micros(20));
+        protect::arm_comparator(pac::COMP1, protect::STACK_HIGH, hook);
+        protect::arm_comparator(pac::COMP3, protect::STACK_LOW, hook);
+        protect::arm_comparator(pac::COMP6, protect::DC_LINK, hook);
         Self {
-            comparator,
-            threshold,
+            _peripherals: peripherals,
+            thresholds,
         }
     }
 
-    /// Moves the threshold (after the zero-current tare changed the calibration).
-    pub fn set_trip(&mut self, trip: OvercurrentTrip) {
-        self.threshold.set(Value::Bit12Right(trip.dac_code()));
+    /// Moves the stack window (after the zero-current tare changed the calibration).
+    pub fn set_stack_window(&mut self, high: u16, low: u16) {
+        let hook = &mut |_| {};
+        protect::set_threshold(pac::DAC3, CH1, high, hook);
+        protect::set_threshold(pac::DAC1, CH1, low, hook);
+        self.thresholds.stack_high = high;
+        self.thresholds.stack_low = low;
     }
 
-    /// The comparator output now: true while the current is above the trip level.
-    pub fn over_threshold(&self) -> bool {
-        self.comparator.output_level()
+    /// The thresholds in force.
+    pub fn thresholds(&self) -> Thresholds {
+        self.thresholds
+    }
+
+    /// The comparator outputs now (COMP1, COMP3, COMP6): true while one requests a break.
+    pub fn outputs(&self) -> [bool; 3] {
+        [
+            protect::comparator_output(pac::COMP1),
+            protect::comparator_output(pac::COMP3),
+            protect::comparator_output(pac::COMP6),
+        ]
     }
 }

@@ -1,16 +1,16 @@
 //! The drive-and-sense task: after the self-check, configure the drive (outputs off), arm the
-//! overcurrent trip, tare the current sense, then sample the sensors, hand every load-cell
+//! overcurrent trips, tare the current sense, then sample the sensors, hand every load-cell
 //! pair to the control loop ([`crate::cells`]) and log them at 2 Hz.
 
 use embassy_stm32::Peri;
-use embassy_stm32::peripherals::{ADC1, COMP1, DAC3, DMA1_CH1, PA0, PA1, PA8, PB0, PB13, TIM1};
+use embassy_stm32::peripherals::{ADC1, DMA1_CH1, PA0, PA1, PA8, PB0, PB13, TIM1};
 use embassy_time::{Duration, Instant};
 use sonolube::drive::{Amplitude, DriveLimits, DriveTiming, OvercurrentTrip};
 use sonolube::sense::{Calibration, SampleError, SensorChannel};
 
 use crate::cells::{self, RawPair};
-use crate::overcurrent::OvercurrentGuard;
-use crate::sensing::{self, Block, CHANNELS, ChannelLog, TRIPLETS_PER_READ};
+use crate::overcurrent::{self, OvercurrentGuard, Thresholds};
+use crate::sensing::{self, Block, CHANNELS, ChannelLog, SCANS_PER_READ};
 use crate::{SELF_CHECK_PASSED, SENSING_STARTED, config, drive, safe};
 
 /// Everything the task owns.
@@ -21,17 +21,15 @@ pub struct Hardware {
     pub high_side: Peri<'static, PA8>,
     /// TIM1_CH1N: low-side gate-driver input.
     pub low_side: Peri<'static, PB13>,
-    /// Overcurrent comparator.
-    pub comparator: Peri<'static, COMP1>,
-    /// Its threshold DAC.
-    pub threshold_dac: Peri<'static, DAC3>,
+    /// Overcurrent comparators, their threshold DACs and inputs.
+    pub protection: overcurrent::Peripherals,
     /// The sensing ADC.
     pub adc: Peri<'static, ADC1>,
     /// Normal-force amplifier output.
     pub normal_force: Peri<'static, PA0>,
     /// Tangential-force (friction) amplifier output.
     pub tangential_force: Peri<'static, PB0>,
-    /// Current-sense amplifier output (also the comparator input).
+    /// Current-sense amplifier output (also COMP1's input; jumpered to COMP3's PC1).
     pub drive_current: Peri<'static, PA1>,
     /// The ADC's DMA channel.
     pub dma: Peri<'static, DMA1_CH1>,
@@ -44,20 +42,26 @@ pub struct Hardware {
 const LOG_PERIOD: Duration = Duration::from_millis(500);
 
 /// Triplets whose current samples, taken with the drive off, are the current sense's zero
-/// (38 ms at 40 kHz).
-const TARE_TRIPLETS: usize = 32;
+/// (19 ms at 40 kHz).
+const TARE_TRIPLETS: usize = 384;
 
 /// The bring-up hold-to-run is polled every this many triplets (38 ms at 40 kHz), the cadence
 /// its ramp was set for ([`config::RAMP_RISE_STEPS`]).
 #[cfg(feature = "bringup")]
-pub const HOLD_POLL_TRIPLETS: u32 = 32;
+pub const HOLD_POLL_TRIPLETS: u32 = 768;
 
 /// The task body. Never returns; on a configuration error it logs and parks with the outputs
 /// off.
-pub async fn run(mut hw: Hardware) {
+pub async fn run(hw: Hardware) {
     SELF_CHECK_PASSED.wait().await;
     let timing = config::TIMING;
-    let _drive = drive::Drive::new(hw.tim1, hw.high_side, hw.low_side, &timing);
+    let _drive = match drive::Drive::new(hw.tim1, hw.high_side, hw.low_side, &timing) {
+        Ok(drive) => drive,
+        Err(refused) => {
+            defmt::error!("TIM1 configuration refused ({}); drive stays off", refused);
+            return;
+        }
+    };
     log_timing(&timing);
 
     let Ok(nominal_current) = config::CURRENT_SENSE.calibration() else {
@@ -68,13 +72,22 @@ pub async fn run(mut hw: Hardware) {
         defmt::error!("overcurrent trip out of the sensor range; drive stays off");
         return;
     };
-    let mut guard = OvercurrentGuard::arm(
-        hw.comparator,
-        hw.drive_current.reborrow(),
-        hw.threshold_dac,
-        trip,
-    );
-    log_trip(trip, &nominal_current);
+    let dc_link_trip = config::DC_LINK_SENSE
+        .calibration()
+        .ok()
+        .and_then(|calibration| {
+            OvercurrentTrip::new(config::DC_LINK_TRIP_CURRENT, &calibration).ok()
+        });
+    let Some(dc_link_trip) = dc_link_trip else {
+        defmt::error!("DC-link trip out of the sensor range; drive stays off");
+        return;
+    };
+    let Some(thresholds) = Thresholds::new(trip, nominal_current.offset(), dc_link_trip) else {
+        defmt::error!("stack-current window out of range; drive stays off");
+        return;
+    };
+    let mut guard = OvercurrentGuard::arm(hw.protection, thresholds);
+    log_trip(guard.thresholds(), &nominal_current);
 
     let Ok(cell) = config::LOAD_CELL_INTERNAL.calibration() else {
         defmt::error!("load-cell calibration out of range");
@@ -85,33 +98,39 @@ pub async fn run(mut hw: Hardware) {
         SensorChannel::new(config::ADC_FORMAT, config::LOAD_CELL_LIMITS, cell),
         SensorChannel::new(config::ADC_FORMAT, config::CURRENT_LIMITS, nominal_current),
     ];
-    let mut ring = sensing::start(
+    let mut ring = match sensing::start(
         hw.adc,
         hw.normal_force,
         hw.tangential_force,
         hw.drive_current,
         hw.dma,
-    );
+    ) {
+        Ok(ring) => ring,
+        Err(error) => {
+            defmt::error!("ADC1 sampling did not start ({}); drive stays off", error);
+            return;
+        }
+    };
     defmt::info!(
-        "ADC1: PA0 normal, PB0 tangential, PA1 current; 16x oversampled on TIM1 TRGO2, \
-         {=u32} ns per conversion in a {=u32} ns quiet window",
-        config::ADC_CONVERSION_NS,
-        timing.quiet_window_ns()
+        "ADC1: PA0 normal, PB0 tangential, PA1 current; one scan per TIM1 TRGO2, \
+         {=u32} ns per scan in a {=u32} ns quiet window; a triplet every {=u32} PWM periods",
+        config::ADC_SCAN_NS,
+        timing.quiet_window_ns(),
+        sensing::TRIGGERS_PER_TRIPLET
     );
 
     // The first triplets, with the drive off, are the current sense's zero (an overrun only
     // loses samples).
-    let mut block: Block = [0; CHANNELS * TRIPLETS_PER_READ];
+    let mut block: Block = [0; CHANNELS * SCANS_PER_READ];
     let mut zero_codes = [0i32; TARE_TRIPLETS];
     let mut taken = 0;
     while taken < TARE_TRIPLETS {
-        if ring.read(&mut block).await.is_ok() {
-            for triplet in block.chunks_exact(CHANNELS) {
-                if let (Some(slot), [_, _, current]) = (zero_codes.get_mut(taken), triplet) {
-                    *slot = i32::from(*current);
-                    taken += 1;
-                }
-            }
+        if ring.read(&mut block).await.is_ok()
+            && let (Some(slot), Some([_, _, current])) =
+                (zero_codes.get_mut(taken), sensing::combine(&block))
+        {
+            *slot = i32::from(current);
+            taken += 1;
         }
     }
     tare_current(&mut channels[2], &zero_codes, &nominal_current, &mut guard);
@@ -128,11 +147,12 @@ pub async fn run(mut hw: Hardware) {
     let mut since_poll: u32 = 0;
     let mut logs = [ChannelLog::new(), ChannelLog::new(), ChannelLog::new()];
     let mut overruns: u32 = 0;
+    let mut malformed: u32 = 0;
     let mut next_log = Instant::now() + LOG_PERIOD;
     loop {
         match ring.read(&mut block).await {
-            Ok(_) => {
-                for triplet in block.chunks_exact(CHANNELS) {
+            Ok(_) => match sensing::combine(&block) {
+                Some(triplet) => {
                     for (i, &code) in triplet.iter().enumerate() {
                         let fault = logs[i].record(&mut channels[i], i32::from(code));
                         // A saturated or disconnected current sense stops the drive at once and
@@ -145,16 +165,22 @@ pub async fn run(mut hw: Hardware) {
                             }
                         }
                     }
-                    if let [normal, tangential, _] = *triplet {
-                        cells::publish(RawPair { normal, tangential });
-                    }
+                    let [normal, tangential, _] = triplet;
+                    cells::publish(RawPair { normal, tangential });
                 }
-            }
+                None => {
+                    // A result wider than 12 bits: the ADC is not in the plan. The current is
+                    // then unknown: the drive goes safe, as for a faulty current sample.
+                    malformed = malformed.saturating_add(1);
+                    drive::set_current_sense_healthy(false);
+                    safe::drive_safe();
+                }
+            },
             Err(_) => overruns = overruns.saturating_add(1),
         }
         #[cfg(feature = "bringup")]
         {
-            since_poll += TRIPLETS_PER_READ as u32;
+            since_poll += sensing::TRIPLETS_PER_READ as u32;
             if since_poll >= HOLD_POLL_TRIPLETS {
                 since_poll = 0;
                 hold.poll();
@@ -162,7 +188,7 @@ pub async fn run(mut hw: Hardware) {
         }
         if Instant::now() >= next_log {
             next_log += LOG_PERIOD;
-            log_sensors(&mut logs, &guard, overruns);
+            log_sensors(&mut logs, &guard, overruns, malformed);
         }
     }
 }
@@ -183,12 +209,19 @@ fn tare_current(
         *current = SensorChannel::new(config::ADC_FORMAT, config::CURRENT_LIMITS, before);
         return;
     }
-    match OvercurrentTrip::new(config::TRIP_CURRENT, &current.calibration()) {
-        Ok(trip) => {
-            guard.set_trip(trip);
-            log_trip(trip, &current.calibration());
+    let tared = current.calibration();
+    let window = OvercurrentTrip::new(config::TRIP_CURRENT, &tared)
+        .ok()
+        .and_then(|trip| {
+            sonolube_g474_hw::protect::window_low_code(tared.offset().to_bits(), trip.dac_code())
+                .map(|low| (trip.dac_code(), low))
+        });
+    match window {
+        Some((high, low)) => {
+            guard.set_stack_window(high, low);
+            log_trip(guard.thresholds(), &tared);
         }
-        Err(_) => defmt::warn!("tared zero leaves no room for the trip; nominal trip kept"),
+        None => defmt::warn!("tared zero leaves no room for the trip window; nominal window kept"),
     }
 }
 
@@ -229,30 +262,47 @@ fn log_timing(timing: &DriveTiming) {
     }
 }
 
-fn log_trip(trip: OvercurrentTrip, calibration: &Calibration) {
+/// The current a DAC code stands for on the channel calibrated by `calibration`, mA.
+fn code_milliamps(code: u16, calibration: &Calibration) -> i32 {
+    let reading = sonolube::fx::Q1_31::from_bits(i32::from(code) << 19);
+    sensing::milli(calibration.apply(reading).value)
+}
+
+fn log_trip(thresholds: Thresholds, calibration: &Calibration) {
     defmt::info!(
-        "overcurrent: COMP1 (PA1) vs DAC3 code {=u16} -> TIM1 break at {=i32} mA",
-        trip.dac_code(),
-        sensing::milli(trip.trip_current(calibration))
+        "overcurrent: stack window COMP1 (PA1) > DAC3 code {=u16} ({=i32} mA) -> BRK, \
+         COMP3 (PC1) < DAC1 code {=u16} ({=i32} mA) -> BRK2; DC link COMP6 (PB11) > DAC4 code \
+         {=u16} -> BRK2",
+        thresholds.stack_high,
+        code_milliamps(thresholds.stack_high, calibration),
+        thresholds.stack_low,
+        code_milliamps(thresholds.stack_low, calibration),
+        thresholds.dc_link
     );
 }
 
-fn log_sensors(logs: &mut [ChannelLog; 3], guard: &OvercurrentGuard, overruns: u32) {
+fn log_sensors(
+    logs: &mut [ChannelLog; 3],
+    guard: &OvercurrentGuard,
+    overruns: u32,
+    malformed: u32,
+) {
     let [normal, tangential, current] = [logs[0].take(), logs[1].take(), logs[2].take()];
     defmt::info!(
         "sense: normal {=i32} mN (code {=i32}), tangential {=i32} mN (code {=i32}), \
-         current {=i32} mA (code {=i32}); comparator {=bool}, break {=bool}, outputs {=bool}, \
-         overruns {=u32}, pairs dropped {=u32}",
+         current {=i32} mA (code {=i32}); comparators {}, break {=bool}, \
+         outputs {=bool}, overruns {=u32}, malformed reads {=u32}, pairs dropped {=u32}",
         normal.0,
         normal.1,
         tangential.0,
         tangential.1,
         current.0,
         current.1,
-        guard.over_threshold(),
+        guard.outputs(),
         drive::break_tripped(),
         drive::outputs_enabled(),
         overruns,
+        malformed,
         cells::dropped()
     );
     for (name, (_, _, faults, last)) in [
