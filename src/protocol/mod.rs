@@ -25,8 +25,9 @@
 //!
 //! # Lines
 //!
-//! A line is at most [`MAX_LINE_LEN`] (96) bytes before its terminator. `\n` ends a line, `\r`
-//! is ignored (so `\r\n` works), tabs count as spaces, and any other byte outside
+//! A line is at most [`MAX_LINE_LEN`] (96) bytes before its terminator. `\n`, `\r` and the
+//! pair `\r\n` each end a line (a terminal sends a lone `\r` on Enter; `\r\n` is one line end,
+//! not a line and an empty one), tabs count as spaces, and any other byte outside
 //! `0x20..=0x7e` makes the line a `bad-encoding` error. Empty and blank lines get no reply.
 //! Words are separated by one or more spaces or tabs; keywords are lowercase and
 //! case-sensitive.
