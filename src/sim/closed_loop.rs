@@ -114,6 +114,17 @@ impl<'a> ClosedLoop<'a> {
         Self::scripted(scene, station, COMMISSIONED)
     }
 
+    /// [`ClosedLoop::new`] with the variant `selection` names ([`Station::with_selection`]):
+    /// the host's selection for a scene file it measured when loading it.
+    pub fn with_selection(
+        scene: &Scene<'a>,
+        selection: crate::variant::Selection,
+    ) -> Result<Self, SimError> {
+        let settings = controller_settings(scene);
+        let station = Station::with_selection(scene, &settings, selection)?;
+        Self::scripted(scene, station, COMMISSIONED)
+    }
+
     /// The run of `scene` with the controller `settings` and the cells' `calibration` given.
     pub fn with_settings(
         scene: &Scene<'a>,
