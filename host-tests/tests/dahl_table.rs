@@ -225,3 +225,42 @@ fn inverse_meets_the_target_on_the_reference() {
         }
     }
 }
+
+/// Issue 13's new user: a copy of `reference` with a 2 N load and a 0.02 m/s slide, a scene the
+/// committed table never measured. The host measures its candidates against the Dahl steady
+/// state with its k_t when it loads it, and picks a measured variant (not "the scene's own").
+#[test]
+fn a_users_scene_file_is_measured_when_loaded() {
+    use sonolube::scene::{Contents, Scene, find};
+    use sonolube::variant::select::{Reason, measured_as_built_in};
+    use sonolube::variant::{Fidelity, select};
+    let reference = find("reference").unwrap();
+    let mine = Scene {
+        name: "my-reference",
+        contents: Contents {
+            load_min_n: 2.0,
+            load_max_n: 2.0,
+            velocity_min_m_per_s: 0.02,
+            velocity_max_m_per_s: 0.02,
+            ..reference.contents
+        },
+        ..*reference
+    };
+    assert!(!measured_as_built_in(&mine));
+    assert!(matches!(select(&mine).reason, Reason::NotMeasured { .. }));
+    let s = sonolube_host::speed::table_rs::select_on_host(&mine).unwrap();
+    assert_eq!(s.required, Some(Fidelity::DahlSteady));
+    let variant = s.variant.expect("a measured choice");
+    assert!(matches!(s.reason, Reason::Meets { .. }), "{s}");
+    let line = format!("{s}");
+    assert!(line.contains("against the Dahl steady state"), "{line}");
+    assert!(
+        line.starts_with(&format!("model {}", variant.name)),
+        "{line}"
+    );
+    // A built-in scene gets the firmware's own choice.
+    assert_eq!(
+        sonolube_host::speed::table_rs::select_on_host(reference).unwrap(),
+        select(reference)
+    );
+}

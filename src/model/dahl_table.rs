@@ -104,26 +104,40 @@ impl DahlGrid {
         (cell, (p & ((1 << 24) - 1)) << 6)
     }
 
-    /// The four Catmull-Rom weights at fraction `t` (Q.30, [0, 1]), in Q.31 (twice the Q.30
-    /// numerators; they sum to exactly 2^31).
+    /// The four Catmull-Rom weights at fraction `t` (Q.30, [0, 1]), in Q.30 (they sum to
+    /// 2^30 up to the rounding of the halving; each within [-0.15, 1]: `i32`, so that the
+    /// products below are single `SMULL`/`SMLAL`s).
     #[inline]
-    fn weights(t: i64) -> [i64; 4] {
+    fn weights(t: i64) -> [i32; 4] {
         let t2 = (t * t) >> 30;
         let t3 = (t2 * t) >> 30;
         [
-            -t3 + 2 * t2 - t,
-            3 * t3 - 5 * t2 + (2 << 30),
-            -3 * t3 + 4 * t2 + t,
-            t3 - t2,
+            ((-t3 + 2 * t2 - t) >> 1) as i32,
+            ((3 * t3 - 5 * t2 + (2 << 30)) >> 1) as i32,
+            ((-3 * t3 + 4 * t2 + t) >> 1) as i32,
+            ((t3 - t2) >> 1) as i32,
         ]
     }
 
-    /// sum w_k n_k, Q.31 weights on Q2.30 nodes, rounded to Q2.30 (|sum| < 1.4 * 2^61: no
+    /// sum w_k n_k, Q.30 weights on Q2.30 nodes, rounded to Q2.30 (|sum| < 1.4 * 2^60: no
     /// overflow for nodes below 1.1 in magnitude and Catmull-Rom weights).
     #[inline]
-    fn dot(w: &[i64; 4], n: &[i32]) -> i64 {
-        let acc = w[0] * n[0] as i64 + w[1] * n[1] as i64 + w[2] * n[2] as i64 + w[3] * n[3] as i64;
-        (acc + (1 << 30)) >> 31
+    fn dot(w: &[i32; 4], n: &[i32; 4]) -> i32 {
+        let acc = w[0] as i64 * n[0] as i64
+            + w[1] as i64 * n[1] as i64
+            + w[2] as i64 * n[2] as i64
+            + w[3] as i64 * n[3] as i64;
+        ((acc + (1 << 29)) >> 30) as i32
+    }
+
+    /// Four nodes from `at` (an index the splits keep inside the padded table: a failed
+    /// lookup, which cannot happen, reads as zeros rather than panicking).
+    #[inline]
+    fn four(&self, at: usize) -> [i32; 4] {
+        match self.nodes.get(at..at + 4) {
+            Some(&[a, b, c, d]) => [a, b, c, d],
+            _ => [0; 4],
+        }
     }
 
     /// R at x (Q2.30 in [0, 1)) and y offset `d` (Q8.24 in [0, 16]): the bicubic Catmull-Rom
@@ -135,25 +149,27 @@ impl DahlGrid {
         let stride = self.stride();
         // Node (i - 1, j - 1) sits at padded (i, j).
         let base = i * stride + j;
-        let row = |r: usize| Self::dot(&wy, &self.nodes[base + r * stride..base + r * stride + 4]);
-        let rows = [row(0), row(1), row(2), row(3)];
-        let acc = wx[0] * rows[0] + wx[1] * rows[1] + wx[2] * rows[2] + wx[3] * rows[3];
-        (acc + (1 << 30)) >> 31
+        let rows = [
+            Self::dot(&wy, &self.four(base)),
+            Self::dot(&wy, &self.four(base + stride)),
+            Self::dot(&wy, &self.four(base + 2 * stride)),
+            Self::dot(&wy, &self.four(base + 3 * stride)),
+        ];
+        Self::dot(&wx, &rows) as i64
     }
 
     /// R along the x node `i` (0..S) at y offset `d` (Q8.24 >= 0): the cubic in y, or beyond
     /// the top edge the extrapolation towards x_i. Q2.30.
     fn column(&self, i: usize, d: i32) -> i64 {
         let top = (16 << 24) as i32;
-        let stride = self.stride();
-        let at = (i + 1) * stride;
+        let at = (i + 1) * self.stride();
         if d > top {
             let x = (i as i64) << (30 - self.steps_log2);
-            let edge = self.nodes[at + self.side] as i64;
+            let edge = self.nodes.get(at + self.side).map_or(0, |&n| n as i64);
             return x + stiff_decay(edge - x, d - top);
         }
         let (j, ty) = self.split_y(d);
-        Self::dot(&Self::weights(ty), &self.nodes[at + j..at + j + 4])
+        Self::dot(&Self::weights(ty), &self.four(at + j)) as i64
     }
 }
 
@@ -333,48 +349,58 @@ impl FrictionModel for DahlTable {
         let grid = self.grid;
         let last = grid.side - 1;
         let min_d = (LN_KXA_MIN as i64) << 24;
-        // R along the curve at x node i (0 at x = 0, 1 at x = 1, ghosts by extrapolation).
-        let curve = |i: isize| -> Result<i64, ModelError> {
-            if i <= 0 || i as usize >= last {
-                return Ok(match i {
-                    0 => 0,
-                    _ if i as usize == last => 1 << 30,
-                    _ => i64::MIN, // ghost: filled in by the caller
-                });
+        // R along the curve at x node i (0 < i < S - 1; 0 at x = 0, 1 at x = 1), or `BELOW`
+        // where the curve leaves the table's soft end.
+        const BELOW: i64 = i64::MIN;
+        let curve = |i: usize| -> i64 {
+            if i == 0 {
+                return 0;
             }
-            let d = ln_tau - grid.ln_sin[i as usize] as i64 - min_d;
+            if i >= last {
+                return 1 << 30;
+            }
+            let g = grid.ln_sin.get(i).map_or(0, |&g| g as i64);
+            let d = ln_tau - g - min_d;
             if d < 0 {
-                return Err(domain("kappa x_a", "below the Dahl table (e^-8)"));
+                return BELOW;
             }
-            Ok(grid.column(i as usize, d.min(i32::MAX as i64) as i32))
+            grid.column(i, d.min(i32::MAX as i64) as i32)
         };
+        let below = || domain("kappa x_a", "below the Dahl table (e^-8)");
         let t = target.to_bits() as i64;
-        // Cell of x_fs, then bisection for the last node at or below the target.
+        // Cell of x_fs, then bisection for the last node at or below the target (the curve
+        // rises with x; a node past the soft end has every later node past it too).
         let mut lo = (x_fs >> (30 - grid.steps_log2)) as usize;
-        if curve(lo as isize)? > t {
+        let start = curve(lo);
+        if start == BELOW {
+            return Err(below());
+        }
+        if start > t {
             return full();
         }
         let mut hi = last; // curve(last) = 1 > target
         while hi - lo > 1 {
             let mid = (lo + hi) / 2;
-            if curve(mid as isize)? <= t {
+            let c = curve(mid);
+            if c == BELOW {
+                return Err(below());
+            }
+            if c <= t {
                 lo = mid;
             } else {
                 hi = mid;
             }
         }
-        let c1 = curve(lo as isize)?;
-        let c2 = curve(hi as isize)?;
-        let c0 = if lo == 0 {
-            2 * c1 - c2
-        } else {
-            curve(lo as isize - 1)?
-        };
+        let (c1, c2) = (curve(lo), curve(hi));
+        let c0 = if lo == 0 { 2 * c1 - c2 } else { curve(lo - 1) };
         let c3 = if hi == last {
             2 * c2 - c1
         } else {
-            curve(hi as isize + 1)?
+            curve(hi + 1)
         };
+        if c0 == BELOW || c3 == BELOW {
+            return Err(below());
+        }
         // Catmull-Rom through c0..c3 on [c1, c2]: p(s) = a0 + a1 s + a2 s^2 + a3 s^3 (Q.30).
         let a1 = (c2 - c0) / 2;
         let a2 = (2 * c0 - 5 * c1 + 4 * c2 - c3) / 2;
