@@ -113,23 +113,23 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady T=33x33",
-        instructions: 956.8,
+        instructions: 927.666,
     },
     Cost {
         variant: "Dahl steady T=65x65",
-        instructions: 956.866,
+        instructions: 927.6,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 591.666,
+        instructions: 591.818,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
-        instructions: 378.181,
+        instructions: 378.03,
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 260.454,
+        instructions: 260.303,
     },
     Cost {
         variant: "cube el N=4 f64",
@@ -137,19 +137,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 829.696,
+        instructions: 829.848,
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 631.818,
+        instructions: 632.121,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
-        instructions: 388.484,
+        instructions: 388.181,
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15228.939,
+        instructions: 15228.484,
     },
     Cost {
         variant: "cube el N=16",
@@ -161,19 +161,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=16 f32 libm",
-        instructions: 647.121,
+        instructions: 647.272,
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26879.393,
+        instructions: 26879.242,
     },
     Cost {
         variant: "cube el N=32",
-        instructions: 2258.03,
+        instructions: 2257.727,
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.666,
+        instructions: 2161.515,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
@@ -181,11 +181,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50122.727,
+        instructions: 50124.09,
     },
     Cost {
         variant: "cube el T=5x5",
-        instructions: 282.575,
+        instructions: 282.727,
     },
     Cost {
         variant: "cube el T=9x9",
@@ -193,15 +193,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el T=17x17",
-        instructions: 282.727,
+        instructions: 282.878,
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 591.969,
+        instructions: 591.818,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 378.03,
+        instructions: 377.878,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
@@ -209,7 +209,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9414.696,
+        instructions: 9414.848,
     },
     Cost {
         variant: "cube ep N=8",
@@ -217,7 +217,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 631.666,
+        instructions: 631.969,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
@@ -225,31 +225,31 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=8 f64",
-        instructions: 15216.515,
+        instructions: 15216.363,
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1306.212,
+        instructions: 1305.757,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
-        instructions: 1141.969,
+        instructions: 1141.818,
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 647.424,
+        instructions: 647.272,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26867.879,
+        instructions: 26868.03,
     },
     Cost {
         variant: "cube ep N=32",
-        instructions: 2258.03,
+        instructions: 2257.878,
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
-        instructions: 2161.666,
+        instructions: 2161.363,
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
@@ -257,7 +257,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50111.363,
+        instructions: 50110.91,
     },
     Cost {
         variant: "cube ep T=5x5",
@@ -265,11 +265,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep T=9x9",
-        instructions: 282.727,
+        instructions: 282.575,
     },
     Cost {
         variant: "cube ep T=17x17",
-        instructions: 282.878,
+        instructions: 282.727,
     },
 ];
 

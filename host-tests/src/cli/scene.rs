@@ -47,12 +47,12 @@ use std::process::ExitCode;
 
 use crate::scene_file::LoadedScene;
 use figure::svg;
-use report::{pass, report, short};
+use report::{pass, report};
 use sonolube::scene::{SCENES, Scene};
 use sonolube::sim::{ClosedLoop, RunSummary};
 
 pub use csv::csv;
-pub use report::{model_line, model_name};
+pub use report::{model_line, model_name, short};
 
 const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml] [--model VARIANT]\n       \
                      sonolube scene --all [--out DIR]\n";
