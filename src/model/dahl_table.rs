@@ -161,7 +161,7 @@ impl DahlGrid {
     /// R along the x node `i` (0..S) at y offset `d` (Q8.24 >= 0): the cubic in y, or beyond
     /// the top edge the extrapolation towards x_i. Q2.30.
     fn column(&self, i: usize, d: i32) -> i64 {
-        let top = (16 << 24) as i32;
+        let top: i32 = 16 << 24;
         let at = (i + 1) * self.stride();
         if d > top {
             let x = (i as i64) << (30 - self.steps_log2);

@@ -228,10 +228,10 @@ pub fn measure() -> Result<Errors, String> {
     let mut scenes = Vec::new();
     for scene in SCENES {
         for (variant, acc, errors) in scene_errors(scene, false)? {
-            if variant.fidelity == errors.reference {
-                if let Some((_, own_acc)) = own.iter_mut().find(|(v, _)| v.name == variant.name) {
-                    own_acc.merge(&acc);
-                }
+            if variant.fidelity == errors.reference
+                && let Some((_, own_acc)) = own.iter_mut().find(|(v, _)| v.name == variant.name)
+            {
+                own_acc.merge(&acc);
             }
             scenes.push(errors);
         }

@@ -105,7 +105,7 @@ pub fn parse(log: &str) -> Result<Counts, String> {
     let builds: Vec<String> = CATALOGUE
         .iter()
         .filter(|v| v.table > 0)
-        .map(|v| table_count_name(v))
+        .map(table_count_name)
         .collect();
     let expected = CATALOGUE
         .iter()
