@@ -81,25 +81,27 @@ impl DahlGrid {
         }
     }
 
+    #[cfg(test)]
     fn stride(&self) -> usize {
         self.side + 2
     }
 
-    /// Cell and fraction (Q.30) of an x in Q2.30, 0 <= x < 1.
-    fn split_x(&self, x: i32) -> (usize, i64) {
-        let shift = 30 - self.steps_log2;
-        let cell = (x >> shift) as usize;
-        let t = ((x as i64) << self.steps_log2) & ((1 << 30) - 1);
+    /// Cell and fraction (Q.30) of an x in Q2.30, 0 <= x < 1, on a grid of 2^K + 1 nodes.
+    #[inline]
+    fn split_x<const K: u32>(x: i32) -> (usize, i64) {
+        let cell = (x >> (30 - K)) as usize;
+        let t = ((x as i64) << K) & ((1 << 30) - 1);
         (cell, t)
     }
 
-    /// Cell and fraction (Q.30) of an offset `d` = y - [`LN_KXA_MIN`] in Q8.24, 0 <= d <= 16.
-    /// The top edge (d = 16) is the last cell at t = 1.
-    fn split_y(&self, d: i32) -> (usize, i64) {
-        let p = (d as i64) << self.steps_log2 >> SPAN_LOG2; // Q.24 position in nodes
+    /// Cell and fraction (Q.30) of an offset `d` = y - [`LN_KXA_MIN`] in Q8.24, 0 <= d <= 16,
+    /// on a grid of 2^K + 1 nodes. The top edge (d = 16) is the last cell at t = 1.
+    #[inline]
+    fn split_y<const K: u32>(d: i32) -> (usize, i64) {
+        let p = (d as i64) << K >> SPAN_LOG2; // Q.24 position in nodes
         let cell = (p >> 24) as usize;
-        if cell >= self.side - 1 {
-            return (self.side - 2, 1 << 30);
+        if cell >= 1 << K {
+            return ((1 << K) - 1, 1 << 30);
         }
         (cell, (p & ((1 << 24) - 1)) << 6)
     }
@@ -141,12 +143,21 @@ impl DahlGrid {
     }
 
     /// R at x (Q2.30 in [0, 1)) and y offset `d` (Q8.24 in [0, 16]): the bicubic Catmull-Rom
-    /// interpolant, Q2.30.
+    /// interpolant, Q2.30. (Dispatched on the size so that every shift and stride is a
+    /// constant.)
     fn bicubic(&self, x: i32, d: i32) -> i64 {
-        let (i, tx) = self.split_x(x);
-        let (j, ty) = self.split_y(d);
+        if self.steps_log2 == 5 {
+            self.bicubic_k::<5>(x, d)
+        } else {
+            self.bicubic_k::<6>(x, d)
+        }
+    }
+
+    fn bicubic_k<const K: u32>(&self, x: i32, d: i32) -> i64 {
+        let (i, tx) = Self::split_x::<K>(x);
+        let (j, ty) = Self::split_y::<K>(d);
         let (wx, wy) = (Self::weights(tx), Self::weights(ty));
-        let stride = self.stride();
+        let stride = (1 << K) + 3;
         // Node (i - 1, j - 1) sits at padded (i, j).
         let base = i * stride + j;
         let rows = [
@@ -161,14 +172,22 @@ impl DahlGrid {
     /// R along the x node `i` (0..S) at y offset `d` (Q8.24 >= 0): the cubic in y, or beyond
     /// the top edge the extrapolation towards x_i. Q2.30.
     fn column(&self, i: usize, d: i32) -> i64 {
+        if self.steps_log2 == 5 {
+            self.column_k::<5>(i, d)
+        } else {
+            self.column_k::<6>(i, d)
+        }
+    }
+
+    fn column_k<const K: u32>(&self, i: usize, d: i32) -> i64 {
         let top: i32 = 16 << 24;
-        let at = (i + 1) * self.stride();
+        let at = (i + 1) * ((1 << K) + 3);
         if d > top {
-            let x = (i as i64) << (30 - self.steps_log2);
-            let edge = self.nodes.get(at + self.side).map_or(0, |&n| n as i64);
+            let x = (i as i64) << (30 - K);
+            let edge = self.nodes.get(at + (1 << K) + 1).map_or(0, |&n| n as i64);
             return x + stiff_decay(edge - x, d - top);
         }
-        let (j, ty) = self.split_y(d);
+        let (j, ty) = Self::split_y::<K>(d);
         Self::dot(&Self::weights(ty), &self.four(at + j)) as i64
     }
 }
@@ -379,6 +398,7 @@ impl FrictionModel for DahlTable {
             return full();
         }
         let mut hi = last; // curve(last) = 1 > target
+        let (mut c1, mut c2) = (start, 1 << 30);
         while hi - lo > 1 {
             let mid = (lo + hi) / 2;
             let c = curve(mid);
@@ -386,12 +406,11 @@ impl FrictionModel for DahlTable {
                 return Err(below());
             }
             if c <= t {
-                lo = mid;
+                (lo, c1) = (mid, c);
             } else {
-                hi = mid;
+                (hi, c2) = (mid, c);
             }
         }
-        let (c1, c2) = (curve(lo), curve(hi));
         let c0 = if lo == 0 { 2 * c1 - c2 } else { curve(lo - 1) };
         let c3 = if hi == last {
             2 * c2 - c1
