@@ -113,15 +113,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady T=33x33",
-        instructions: 927.666,
+        instructions: 915.8,
     },
     Cost {
         variant: "Dahl steady T=65x65",
-        instructions: 927.6,
+        instructions: 917.733,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 591.818,
+        instructions: 592.121,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
@@ -129,11 +129,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 260.303,
+        instructions: 260.454,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9423.636,
+        instructions: 9423.787,
     },
     Cost {
         variant: "cube el N=8",
@@ -141,7 +141,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 632.121,
+        instructions: 631.666,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
