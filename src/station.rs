@@ -117,6 +117,20 @@ impl Station {
         Self::assemble(scene, settings, model, Some(selection), normal, tangential)
     }
 
+    /// [`Station::new`] with a selection made elsewhere: the host's, for a scene file whose
+    /// candidates it measured when it loaded the file (`sonolube scene --file`).
+    /// Errors: as [`Station::new`].
+    pub fn with_selection(
+        scene: &Scene<'_>,
+        settings: &Settings,
+        selection: Selection,
+        normal: SensorChannel,
+        tangential: SensorChannel,
+    ) -> Result<Self, StationError> {
+        let model = selection.build(scene).map_err(StationError::Model)?;
+        Self::assemble(scene, settings, model, Some(selection), normal, tangential)
+    }
+
     /// [`Station::new`] with the controller running `model` instead of the selected variant
     /// (a benchmark timing one fidelity level; [`Station::selection`] is then `None`).
     pub fn with_model(

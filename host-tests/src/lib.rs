@@ -5,6 +5,7 @@
 //! command-line tool's building blocks.
 
 pub mod cli;
+pub mod dahl_table;
 pub mod fixed_eval;
 pub mod monitor;
 pub mod papers;

@@ -7,7 +7,7 @@ use sonolube::fx::{Q1_31, Q8_24, Q16_16};
 use sonolube::model::OperatingPoint;
 use sonolube::scene::SCENES;
 use sonolube::variant::grid::GridPoint;
-use sonolube::variant::{CATALOGUE, Model};
+use sonolube::variant::{CATALOGUE, Family, Model};
 use sonolube_host::speed::reference;
 
 /// Loads and amplitudes of the dense grid (amplitudes k / 96: 1 in 3 is not a node of any
@@ -43,7 +43,11 @@ fn amplitude(k: u32) -> Q1_31 {
 
 #[test]
 fn every_table_meets_its_bound_over_the_tabulated_range() {
-    let tables: Vec<_> = CATALOGUE.iter().filter(|v| v.table > 0).collect();
+    // The cube tables (the Dahl tables have their own test, `dahl_table.rs`).
+    let tables: Vec<_> = CATALOGUE
+        .iter()
+        .filter(|v| v.table > 0 && v.fidelity.family() == Family::Cube)
+        .collect();
     assert!(tables.len() >= 6);
     assert!(tables.iter().all(|v| v.table <= 17));
     let mut checked = 0;

@@ -30,6 +30,16 @@ pub fn fidelity(kind: ModelKind) -> u8 {
     }
 }
 
+/// Whether a plant of kind `plant` is of strictly higher fidelity than a controller of kind
+/// `controller` (issue 13): higher in the order of [`fidelity`], or both `dahl`, where the
+/// plant integrates the Dahl law in time, transients included, while the controller evaluates
+/// its periodic steady state (a strictly coarser description of the same contact). Equal cube
+/// or Coulomb kinds are refused: there the plant evaluates the same average the controller does.
+pub fn plant_outranks(plant: ModelKind, controller: ModelKind) -> bool {
+    fidelity(plant) > fidelity(controller)
+        || (plant == ModelKind::Dahl && controller == ModelKind::Dahl)
+}
+
 /// Whether `name` is a valid scene name: the rule of `sonolube::protocol::is_scene_name`.
 pub fn is_scene_name(name: &str) -> bool {
     !name.is_empty()
@@ -84,11 +94,12 @@ pub(crate) fn scene(raw: RawScene, errors: Errors<'_>) -> Result<SceneDescriptio
     };
     let controller = model(errors, "controller", &raw.controller)?;
     let plant = model(errors, "plant", &raw.plant)?;
-    if fidelity(plant.kind) <= fidelity(controller.kind) {
+    if !plant_outranks(plant.kind, controller.kind) {
         return Err(errors.at(
             "plant.model",
             "the plant's model must be of higher fidelity than the controller's \
-             (order: coulomb < exp-coulomb < dahl < cube-elastic < cube-elastic-plastic)",
+             (order: coulomb < exp-coulomb < dahl < cube-elastic < cube-elastic-plastic; \
+             dahl on both sides is allowed: the plant integrates the law in time)",
         ));
     }
     let mismatch = Mismatch {

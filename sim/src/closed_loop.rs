@@ -119,6 +119,19 @@ impl<'a> ClosedLoop<'a> {
         Self::scripted(scene, station, COMMISSIONED)
     }
 
+    /// [`ClosedLoop::new`] with the variant `selection` names ([`Station::with_selection`]):
+    /// the host's selection for a scene file it measured when loading it.
+    pub fn with_selection(
+        scene: &Scene<'a>,
+        selection: sonolube::variant::Selection,
+    ) -> Result<Self, SimError> {
+        let settings = controller_settings(scene);
+        let normal = super::sensor_channel(&scene.normal_cell)?;
+        let tangential = super::sensor_channel(&scene.tangential_cell)?;
+        let station = Station::with_selection(scene, &settings, selection, normal, tangential)?;
+        Self::scripted(scene, station, COMMISSIONED)
+    }
+
     /// The run of `scene` with the controller `settings` and the cells' `calibration` given.
     pub fn with_settings(
         scene: &Scene<'a>,

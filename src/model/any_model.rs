@@ -13,6 +13,7 @@ use crate::model::cube_model::CubeModel;
 use crate::model::cube_table::CubeTable;
 use crate::model::dahl::DahlParams;
 use crate::model::dahl_steady::DahlModel;
+use crate::model::dahl_table::DahlTable;
 use crate::model::exp_average::ExpCoulombVibrated;
 use crate::model::horn::UPhase;
 use crate::model::quadrature::SlipWindow;
@@ -48,6 +49,9 @@ pub enum AnyModel {
     /// loads outside the table (a model variant only: no scene kind names it;
     /// `crate::variant::select` chooses it).
     CubeTable(CubeTable),
+    /// Dahl steady state interpolated in a table compiled into flash (a model variant only,
+    /// chosen by `crate::variant::select`; [`crate::model::dahl_table`]).
+    DahlTable(DahlTable),
 }
 
 impl AnyModel {
@@ -112,7 +116,7 @@ impl AnyModel {
         match self {
             AnyModel::Coulomb(_) => ModelKind::Coulomb,
             AnyModel::ExpCoulomb(_) => ModelKind::ExpCoulomb,
-            AnyModel::Dahl(_) => ModelKind::Dahl,
+            AnyModel::Dahl(_) | AnyModel::DahlTable(_) => ModelKind::Dahl,
             AnyModel::Cube(model) => cube_kind(model),
             AnyModel::CubeTable(table) => cube_kind(table.exact()),
         }
@@ -127,6 +131,7 @@ impl FrictionModel for AnyModel {
             AnyModel::Dahl(model) => model.ratio(point, amplitude),
             AnyModel::Cube(model) => model.ratio(point, amplitude),
             AnyModel::CubeTable(model) => model.ratio(point, amplitude),
+            AnyModel::DahlTable(model) => model.ratio(point, amplitude),
         }
     }
 
@@ -137,6 +142,7 @@ impl FrictionModel for AnyModel {
             AnyModel::Dahl(model) => model.invert(point, target),
             AnyModel::Cube(model) => model.invert(point, target),
             AnyModel::CubeTable(model) => model.invert(point, target),
+            AnyModel::DahlTable(model) => model.invert(point, target),
         }
     }
 
@@ -152,6 +158,7 @@ impl FrictionModel for AnyModel {
             AnyModel::Dahl(model) => model.invert_from(point, target, start),
             AnyModel::Cube(model) => model.invert_from(point, target, start),
             AnyModel::CubeTable(model) => model.invert_from(point, target, start),
+            AnyModel::DahlTable(model) => model.invert_from(point, target, start),
         }
     }
 }

@@ -23,6 +23,9 @@ pub mod cube_model;
 mod cube_nodes;
 pub mod cube_table;
 pub mod dahl;
+pub mod dahl_table;
+#[rustfmt::skip]
+pub mod dahl_table_nodes;
 pub(crate) mod dahl_cycle;
 pub(crate) mod dahl_quadrature;
 pub mod dahl_relax;

@@ -21,6 +21,7 @@ use crate::model::cube_model::CubeModel;
 use crate::model::cube_table::CubeTable;
 use crate::model::dahl::DahlParams;
 use crate::model::dahl_steady::DahlModel;
+use crate::model::dahl_table::{DahlGrid, DahlTable};
 use crate::model::horn::UPhase;
 use crate::model::quadrature::SlipWindow;
 use crate::scene::Scene;
@@ -43,6 +44,15 @@ pub fn buildable(scene: &Scene<'_>, fidelity: Fidelity) -> bool {
             scene.horn.is_some() && scene.controller.surface.is_some()
         }
     }
+}
+
+/// Whether `variant` can be built for `scene`: [`buildable`] for its level, and for a Dahl
+/// table alpha = 1 (the tables in flash are for alpha = 1 only).
+pub fn variant_buildable(scene: &Scene<'_>, variant: &Variant) -> bool {
+    buildable(scene, variant.fidelity)
+        && !(variant.fidelity == Fidelity::DahlSteady
+            && variant.table > 0
+            && scene.controller.dahl_alpha.unwrap_or(1.0) != 1.0)
 }
 
 /// Dahl parameters of the scene's controller at `points` nodes per period.
@@ -102,6 +112,17 @@ pub fn fixed_model(scene: &Scene<'_>, variant: &Variant) -> Result<AnyModel, Mod
         Fidelity::Coulomb => Ok(AnyModel::Coulomb(CoulombModel {
             constants: CoulombConstants::new(scene.controller.mu, frequency_hz, amplitude_m)?,
         })),
+        Fidelity::DahlSteady if variant.table > 0 => {
+            let grid =
+                DahlGrid::of_side(usize::from(variant.table)).ok_or(ModelError::OutOfDomain {
+                    input: "variant",
+                    reason: "no Dahl table of this size",
+                })?;
+            Ok(AnyModel::DahlTable(DahlTable::new(
+                &dahl_params(scene, u32::from(variant.points))?,
+                grid,
+            )?))
+        }
         Fidelity::DahlSteady => Ok(AnyModel::Dahl(DahlModel::new(&dahl_params(
             scene,
             u32::from(variant.points),

@@ -7,15 +7,18 @@
 //!
 //! 1. **No normal vibration: no contact re-evaluation.** Without out-of-plane motion the contact
 //!    (separation, real area) does not change over the cycle, so no cube model: the in-plane
-//!    family (Coulomb, Dahl). The required level is the scene's controller model (`dahl` when it
-//!    asks for the contact's compliance, Coulomb otherwise).
+//!    family (Coulomb, Dahl). The reference is the scene's physics, not the model its file
+//!    names (issue 13): with a finite contact stiffness (`k_t_n_per_m`) the Dahl steady state
+//!    with the scene's k_t and alpha, so a stiff contact keeps the Coulomb ratio only where the
+//!    ratio is within budget of Dahl; without k_t (a rigid contact) the Coulomb ratio.
 //! 2. **Normal vibration: the contact is re-evaluated**, and the complete contact is the
 //!    elastic-plastic one. The elastic contact (no plastic terms) is a candidate like any other:
 //!    it is chosen when its measured error against the elastic-plastic reference over the
 //!    scene's load range meets the budget (and it is not dearer).
 //! 3. Among the candidates (fixed point, the required level or a reduced one in the same family,
-//!    every quadrature knob and table size) the errors are measured against the required
-//!    level's exact `f64` model; the cheapest in Cortex-M4 instructions that meets the budget
+//!    every quadrature knob and table size: the Coulomb ratio, the Dahl steady state at N = 16
+//!    to 64 and its tables `T=33x33`, `T=65x65`) the errors are measured against the reference
+//!    level's exact `f64` model, and the reason line names that reference; the cheapest in Cortex-M4 instructions that meets the budget
 //!    wins, costs within [`COST_RESOLUTION`] of it counting as ties, which go to the lower level
 //!    (fewer parts), then to the more accurate (the table sizes cost the same per evaluation). When none meets it, the most accurate variant of the
 //!    required level is taken and the reason says so.
@@ -33,7 +36,7 @@
 
 use core::fmt;
 
-use super::fixed::{buildable, fixed_model};
+use super::fixed::{buildable, fixed_model, variant_buildable};
 use super::{CATALOGUE, Family, Fidelity, Form, Variant, table};
 use crate::model::AnyModel;
 use crate::model::ModelError;
@@ -219,22 +222,36 @@ fn not_measured(scene: &Scene<'_>) -> Selection {
     }
 }
 
-/// The family and required level of `scene` (module docs, steps 1-2); `None` when the scene's
-/// controller model is outside the catalogue or lacks the parameters of the required level.
+/// The family and the reference level of `scene`: the most faithful model of its contact the
+/// project has, from its physics (issue 13), not from the model its file names. Normal
+/// vibration: the elastic-plastic cube model. In-plane vibration with a finite contact
+/// stiffness (`k_t_n_per_m` in `[controller]`): the Dahl steady state with the scene's k_t
+/// and alpha. In-plane without k_t: the rigid contact's Coulomb ratio. `None` when the scene's
+/// controller model is outside the catalogue (`exp-coulomb`) or lacks the reference level's
+/// parameters.
 pub fn required_fidelity(scene: &Scene<'_>) -> Option<(Family, Fidelity)> {
+    if scene.controller.kind == ModelKind::ExpCoulomb {
+        return None;
+    }
     let required = if scene.contents.normal_vibration {
         Fidelity::CubeElasticPlastic
+    } else if scene.controller.k_t_n_per_m.is_some() {
+        Fidelity::DahlSteady
     } else {
-        match scene.controller.kind {
-            ModelKind::Dahl => Fidelity::DahlSteady,
-            ModelKind::ExpCoulomb => return None,
-            // Coulomb, or a cube model without normal vibration: nothing to re-evaluate.
-            ModelKind::Coulomb | ModelKind::CubeElastic | ModelKind::CubeElasticPlastic => {
-                Fidelity::Coulomb
-            }
-        }
+        Fidelity::Coulomb
     };
     buildable(scene, required).then_some((required.family(), required))
+}
+
+/// The reference level in words, for the reason line.
+pub const fn reference_name(level: Fidelity) -> &'static str {
+    match level {
+        Fidelity::DahlSteady => "the Dahl steady state (the scene's k_t and alpha)",
+        Fidelity::CubeElasticPlastic => "the elastic-plastic cube model",
+        Fidelity::CubeElastic => "the elastic cube model",
+        Fidelity::Coulomb => "the Coulomb ratio (rigid contact: no k_t)",
+        Fidelity::Littmann | Fidelity::DahlUpdate => "a kernel",
+    }
 }
 
 /// A candidate with its measurements.
@@ -258,7 +275,7 @@ pub fn select_from(scene: &Scene<'_>, measured: &Measurements) -> Selection {
                 v.form == Form::Fixed
                     && v.fidelity.family() == family
                     && v.fidelity <= required
-                    && buildable(scene, v.fidelity)
+                    && variant_buildable(scene, v)
             })
             .filter_map(move |v| {
                 Some(Candidate {
@@ -436,6 +453,7 @@ impl fmt::Display for Parts {
 impl fmt::Display for Selection {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let name = self.variant.map_or("(own model)", |v| v.name);
+        let against = self.required.map_or("-", reference_name);
         match self.reason {
             Reason::Meets {
                 error_pct,
@@ -445,9 +463,9 @@ impl fmt::Display for Selection {
                 candidates,
             } => write!(
                 f,
-                "model {name}: the cheapest within budget of {candidates} measured, \
-                 {instructions:.0} instructions, max error {error_pct:.2e} % <= {budget_pct} % \
-                 of natural friction over {points} points",
+                "model {name}: the cheapest within budget of {candidates} measured against \
+                 {against}, {instructions:.0} instructions, max error {error_pct:.2e} % <= \
+                 {budget_pct} % of natural friction over {points} points",
             )?,
             Reason::NoneMeets {
                 error_pct,
@@ -456,8 +474,9 @@ impl fmt::Display for Selection {
                 points,
             } => write!(
                 f,
-                "model {name}: NO variant meets the budget {budget_pct} %; most accurate, \
-                 {instructions:.0} instructions, max error {error_pct:.2e} % over {points} points",
+                "model {name}: NO variant meets the budget {budget_pct} % against {against}; \
+                 most accurate, {instructions:.0} instructions, max error {error_pct:.2e} % over \
+                 {points} points",
             )?,
             Reason::NotMeasured { kind } => {
                 return write!(
@@ -477,6 +496,7 @@ impl fmt::Display for Selection {
 impl defmt::Format for Selection {
     fn format(&self, f: defmt::Formatter) {
         let name = self.variant.map_or("(own model)", |v| v.name);
+        let against = self.required.map_or("-", reference_name);
         match self.reason {
             Reason::Meets {
                 error_pct,
@@ -486,9 +506,10 @@ impl defmt::Format for Selection {
                 candidates,
             } => defmt::write!(
                 f,
-                "model {=str}: the cheapest within budget of {=u8} measured, {=u32} instructions, max error {=f32} % <= {=f32} % of natural friction over {=u16} points",
+                "model {=str}: the cheapest within budget of {=u8} measured against {=str}, {=u32} instructions, max error {=f32} % <= {=f32} % of natural friction over {=u16} points",
                 name,
                 candidates,
+                against,
                 whole(instructions),
                 error_pct,
                 budget_pct,
@@ -501,9 +522,10 @@ impl defmt::Format for Selection {
                 points,
             } => defmt::write!(
                 f,
-                "model {=str}: NO variant meets the budget {=f32} %; most accurate, {=u32} instructions, max error {=f32} % over {=u16} points",
+                "model {=str}: NO variant meets the budget {=f32} % against {=str}; most accurate, {=u32} instructions, max error {=f32} % over {=u16} points",
                 name,
                 budget_pct,
+                against,
                 whole(instructions),
                 error_pct,
                 points

@@ -194,6 +194,14 @@ fn in_plane_scenes_use_the_in_plane_family_and_may_skip_the_compliance() {
         ("cube ep N=4", 10.0),
     ];
     let reference = find("reference").unwrap();
+    // A rigid contact (no k_t): the Coulomb ratio is the reference.
+    let rigid = Scene {
+        controller: ModelSpec {
+            k_t_n_per_m: None,
+            ..reference.controller
+        },
+        ..*reference
+    };
     let m = measured(
         &costs,
         &[
@@ -201,13 +209,22 @@ fn in_plane_scenes_use_the_in_plane_family_and_may_skip_the_compliance() {
             ("reference", "cube ep N=4", Fidelity::Coulomb, 0.0),
         ],
     );
-    let s = select_from(reference, &m);
+    let s = select_from(&rigid, &m);
     assert_eq!(s.variant.map(|v| v.name), Some("Coulomb ratio"));
+    assert_eq!(s.required, Some(Fidelity::Coulomb));
     assert_eq!(s.parts, Some(Parts::InPlane { compliance: None }));
     assert!(std::format!("{s}").contains("contact not re-evaluated"));
+    assert!(std::format!("{s}").contains("against the Coulomb ratio (rigid contact"));
 
-    // The same scene asking for the Dahl model: Coulomb is within 0.25 % -> compliance skipped;
-    // then not -> the cheapest Dahl within budget.
+    // With its finite k_t the scene's physics is Dahl, whatever model its file names (issue
+    // 13): measured only against Coulomb, nothing is measured against the reference.
+    assert_eq!(
+        required_fidelity(reference),
+        Some((Family::InPlane, Fidelity::DahlSteady))
+    );
+    assert_eq!(select_from(reference, &m).variant, None);
+    // Coulomb within 0.25 % of Dahl -> compliance skipped; then not -> the cheapest Dahl
+    // within budget; the same for a file naming `dahl`.
     let dahl = Scene {
         controller: ModelSpec {
             kind: ModelKind::Dahl,
@@ -224,8 +241,10 @@ fn in_plane_scenes_use_the_in_plane_family_and_may_skip_the_compliance() {
             ("reference", "Dahl steady N=64", d, 0.0001),
         ],
     );
+    assert_eq!(select_from(reference, &near), select_from(&dahl, &near));
     let s = select_from(&dahl, &near);
     assert_eq!(s.variant.map(|v| v.name), Some("Coulomb ratio"));
+    assert!(std::format!("{s}").contains("against the Dahl steady state (the scene's k_t"));
     assert!(matches!(
         s.parts,
         Some(Parts::InPlane {

@@ -17,7 +17,7 @@ pub static MEASURED: Measurements = Measurements {
 static COSTS: &[Cost] = &[
     Cost {
         variant: "Littmann closed form",
-        instructions: 45.131,
+        instructions: 45.093,
     },
     Cost {
         variant: "Littmann closed form f32 micromath",
@@ -25,19 +25,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Littmann closed form f32 libm",
-        instructions: 417.769,
+        instructions: 417.807,
     },
     Cost {
         variant: "Littmann closed form f64",
-        instructions: 3356.036,
+        instructions: 3356.017,
     },
     Cost {
         variant: "Dahl update",
-        instructions: 43.829,
+        instructions: 43.76,
     },
     Cost {
         variant: "Dahl update f32 micromath",
-        instructions: 107.213,
+        instructions: 107.247,
     },
     Cost {
         variant: "Dahl update f32 libm",
@@ -45,75 +45,83 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl update f64",
-        instructions: 2228.17,
+        instructions: 2228.034,
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 294.876,
+        instructions: 314.523,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 68.703,
+        instructions: 68.809,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 242.839,
+        instructions: 245.535,
     },
     Cost {
         variant: "Coulomb ratio f64",
-        instructions: 2700.555,
+        instructions: 2704.583,
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11293.194,
+        instructions: 11246.333,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 6010.347,
+        instructions: 6011.933,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 32638.193,
+        instructions: 32539.266,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 150957.84,
+        instructions: 149775.53,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20120.0,
+        instructions: 20021.732,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
-        instructions: 11569.791,
+        instructions: 11565.933,
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 60074.723,
+        instructions: 59899.266,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 276634.1,
+        instructions: 274442.53,
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 37617.43,
+        instructions: 37425.664,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22718.125,
+        instructions: 22702.332,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 114685.07,
+        instructions: 114337.664,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 523976.88,
+        instructions: 519900.28,
+    },
+    Cost {
+        variant: "Dahl steady T=33x33",
+        instructions: 915.8,
+    },
+    Cost {
+        variant: "Dahl steady T=65x65",
+        instructions: 917.733,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 591.818,
+        instructions: 592.121,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
@@ -121,31 +129,31 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 260.151,
+        instructions: 260.454,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9423.939,
+        instructions: 9423.787,
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 830.0,
+        instructions: 829.848,
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 631.969,
+        instructions: 631.666,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
-        instructions: 388.484,
+        instructions: 388.181,
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15228.636,
+        instructions: 15228.484,
     },
     Cost {
         variant: "cube el N=16",
-        instructions: 1305.757,
+        instructions: 1305.909,
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
@@ -153,11 +161,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=16 f32 libm",
-        instructions: 646.969,
+        instructions: 647.272,
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26879.545,
+        instructions: 26879.242,
     },
     Cost {
         variant: "cube el N=32",
@@ -165,15 +173,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.818,
+        instructions: 2161.515,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
-        instructions: 1162.878,
+        instructions: 1162.727,
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50123.18,
+        instructions: 50124.09,
     },
     Cost {
         variant: "cube el T=5x5",
@@ -181,19 +189,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el T=9x9",
-        instructions: 282.727,
+        instructions: 282.575,
     },
     Cost {
         variant: "cube el T=17x17",
-        instructions: 282.727,
+        instructions: 282.878,
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 591.969,
+        instructions: 591.818,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 378.03,
+        instructions: 377.878,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
@@ -201,15 +209,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9414.545,
+        instructions: 9414.848,
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 829.696,
+        instructions: 830.0,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 632.121,
+        instructions: 631.969,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
@@ -221,7 +229,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1306.212,
+        instructions: 1305.757,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
@@ -229,19 +237,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 646.969,
+        instructions: 647.272,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26867.424,
+        instructions: 26868.03,
     },
     Cost {
         variant: "cube ep N=32",
-        instructions: 2257.727,
+        instructions: 2257.878,
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
-        instructions: 2161.515,
+        instructions: 2161.363,
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
@@ -261,7 +269,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep T=17x17",
-        instructions: 282.575,
+        instructions: 282.727,
     },
 ];
 
@@ -274,6 +282,55 @@ static ERRORS: &[SceneError] = &[
         reference: Fidelity::Coulomb,
         max_error: 1.14e-9,
         points: 72,
+    },
+    SceneError {
+        scene: "compliant",
+        variant: "Coulomb ratio",
+        reference: Fidelity::Coulomb,
+        max_error: 4.79e-10,
+        points: 24,
+    },
+    SceneError {
+        scene: "compliant",
+        variant: "Coulomb ratio",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.387,
+        points: 24,
+    },
+    SceneError {
+        scene: "compliant",
+        variant: "Dahl steady N=16",
+        reference: Fidelity::DahlSteady,
+        max_error: 8.1e-5,
+        points: 24,
+    },
+    SceneError {
+        scene: "compliant",
+        variant: "Dahl steady N=32",
+        reference: Fidelity::DahlSteady,
+        max_error: 1.99e-5,
+        points: 24,
+    },
+    SceneError {
+        scene: "compliant",
+        variant: "Dahl steady N=64",
+        reference: Fidelity::DahlSteady,
+        max_error: 4.92e-6,
+        points: 24,
+    },
+    SceneError {
+        scene: "compliant",
+        variant: "Dahl steady T=33x33",
+        reference: Fidelity::DahlSteady,
+        max_error: 4.09e-6,
+        points: 24,
+    },
+    SceneError {
+        scene: "compliant",
+        variant: "Dahl steady T=65x65",
+        reference: Fidelity::DahlSteady,
+        max_error: 8.27e-7,
+        points: 24,
     },
     SceneError {
         scene: "horn-al-ss",
@@ -752,6 +809,20 @@ static ERRORS: &[SceneError] = &[
         points: 24,
     },
     SceneError {
+        scene: "reference",
+        variant: "Dahl steady T=33x33",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.000254,
+        points: 24,
+    },
+    SceneError {
+        scene: "reference",
+        variant: "Dahl steady T=65x65",
+        reference: Fidelity::DahlSteady,
+        max_error: 2.29e-5,
+        points: 24,
+    },
+    SceneError {
         scene: "seatbelt",
         variant: "Coulomb ratio",
         reference: Fidelity::Coulomb,
@@ -787,6 +858,20 @@ static ERRORS: &[SceneError] = &[
         points: 360,
     },
     SceneError {
+        scene: "seatbelt",
+        variant: "Dahl steady T=33x33",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.000854,
+        points: 360,
+    },
+    SceneError {
+        scene: "seatbelt",
+        variant: "Dahl steady T=65x65",
+        reference: Fidelity::DahlSteady,
+        max_error: 6.55e-5,
+        points: 360,
+    },
+    SceneError {
         scene: "sensor-fault",
         variant: "Coulomb ratio",
         reference: Fidelity::Coulomb,
@@ -822,6 +907,20 @@ static ERRORS: &[SceneError] = &[
         points: 24,
     },
     SceneError {
+        scene: "sensor-fault",
+        variant: "Dahl steady T=33x33",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.000254,
+        points: 24,
+    },
+    SceneError {
+        scene: "sensor-fault",
+        variant: "Dahl steady T=65x65",
+        reference: Fidelity::DahlSteady,
+        max_error: 2.29e-5,
+        points: 24,
+    },
+    SceneError {
         scene: "sensor-spike",
         variant: "Coulomb ratio",
         reference: Fidelity::Coulomb,
@@ -857,6 +956,20 @@ static ERRORS: &[SceneError] = &[
         points: 24,
     },
     SceneError {
+        scene: "sensor-spike",
+        variant: "Dahl steady T=33x33",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.000254,
+        points: 24,
+    },
+    SceneError {
+        scene: "sensor-spike",
+        variant: "Dahl steady T=65x65",
+        reference: Fidelity::DahlSteady,
+        max_error: 2.29e-5,
+        points: 24,
+    },
+    SceneError {
         scene: "sensor-stuck",
         variant: "Coulomb ratio",
         reference: Fidelity::Coulomb,
@@ -889,6 +1002,20 @@ static ERRORS: &[SceneError] = &[
         variant: "Dahl steady N=64",
         reference: Fidelity::DahlSteady,
         max_error: 0.00045,
+        points: 24,
+    },
+    SceneError {
+        scene: "sensor-stuck",
+        variant: "Dahl steady T=33x33",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.000254,
+        points: 24,
+    },
+    SceneError {
+        scene: "sensor-stuck",
+        variant: "Dahl steady T=65x65",
+        reference: Fidelity::DahlSteady,
+        max_error: 2.29e-5,
         points: 24,
     },
     SceneError {
@@ -924,6 +1051,20 @@ static ERRORS: &[SceneError] = &[
         variant: "Dahl steady N=64",
         reference: Fidelity::DahlSteady,
         max_error: 1.35e-5,
+        points: 120,
+    },
+    SceneError {
+        scene: "stack-rail",
+        variant: "Dahl steady T=33x33",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.000124,
+        points: 120,
+    },
+    SceneError {
+        scene: "stack-rail",
+        variant: "Dahl steady T=65x65",
+        reference: Fidelity::DahlSteady,
+        max_error: 1.29e-5,
         points: 120,
     },
 ];

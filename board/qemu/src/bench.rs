@@ -26,8 +26,10 @@
 //! (`ClosedLoop::with_model`, not the variant the scene selects); the plant's phase is not
 //! timed.
 //!
-//! The table variants' build (`CubeTable::new`, at scene start) is timed once per cube scene:
-//! `bench build NAME: ...`, the mean over the scenes.
+//! The cube table variants' build (`CubeTable::new`, at scene start) is timed once per cube
+//! scene: `bench build NAME: ...`, the mean over the scenes. The Dahl table variants (in flash,
+//! nothing to build) have their inverse timed over the in-plane scenes' grids, the target being
+//! the ratio at each grid point: `bench inverse NAME: ...`.
 //!
 //! Output, one line per measurement (parsed by `sonolube speed`):
 //! `bench NAME: N.NNN instructions per call (C calls)`.
@@ -35,7 +37,7 @@
 use core::hint::black_box;
 use core::mem::MaybeUninit;
 
-use sonolube::fx::Q1_31;
+use sonolube::fx::{Q1_31, Q2_30};
 use sonolube::model::AnyModel;
 use sonolube::model::cube_table::CubeTable;
 use sonolube::model::{FrictionModel, OperatingPoint, dahl, littmann};
@@ -99,6 +101,22 @@ impl Tally {
         };
         defmt::info!(
             "bench {=str}: {=u64}.{=u64:03} instructions per call ({=u64} calls)",
+            name,
+            milli / 1000,
+            milli % 1000,
+            self.calls
+        );
+    }
+
+    /// Prints `bench PREFIXNAME: N.NNN instructions per call (C calls)`.
+    fn report_as(&self, prefix: &str, name: &str, shift: u32) {
+        let Some(milli) = milli_instructions(self.cycles, self.calls, shift) else {
+            defmt::error!("bench {=str}{=str}: no calls", prefix, name);
+            return;
+        };
+        defmt::info!(
+            "bench {=str}{=str}: {=u64}.{=u64:03} instructions per call ({=u64} calls)",
+            prefix,
             name,
             milli / 1000,
             milli % 1000,
@@ -244,7 +262,7 @@ fn model(variant: &Variant, shift: u32) -> bool {
         .iter()
         .filter(|s| family(s) == variant.fidelity.family())
     {
-        if !sonolube::variant::fixed::buildable(scene, variant.fidelity) {
+        if !sonolube::variant::fixed::variant_buildable(scene, variant) {
             continue;
         }
         let built = match Model::new(scene, variant) {
@@ -276,6 +294,36 @@ fn model(variant: &Variant, shift: u32) -> bool {
         }
     }
     tally.report(variant.name, shift);
+    true
+}
+
+/// Times the inverse of a Dahl table variant over every in-plane scene that can build it, the
+/// target at each grid point being the model's ratio there (so every inverse has an answer);
+/// prints `bench inverse NAME: ...`. False if the model cannot be built.
+fn inverse(variant: &Variant, shift: u32) -> bool {
+    let mut tally = Tally::default();
+    for scene in SCENES.iter().filter(|s| family(s) == Family::InPlane) {
+        if !sonolube::variant::fixed::variant_buildable(scene, variant) {
+            continue;
+        }
+        let Ok(model) = fixed_model(scene, variant) else {
+            defmt::error!(
+                "bench inverse {=str}: scene {=str}",
+                variant.name,
+                scene.name
+            );
+            return false;
+        };
+        let grid = SceneGrid::new(scene);
+        let make = |i| {
+            let p = grid.at(i);
+            let target = model.ratio(&p.point, p.amplitude).unwrap_or(Q2_30::ONE);
+            (p.point, target)
+        };
+        let call = |(point, target): (OperatingPoint, Q2_30)| model.invert(&point, target);
+        time(grid.len(), make, call, &mut tally);
+    }
+    tally.report_as("inverse ", variant.name, shift);
     true
 }
 
@@ -417,7 +465,11 @@ pub fn run() -> bool {
     }
     for variant in CATALOGUE.iter().filter(|v| v.table > 0) {
         watchdog::feed();
-        ok &= table_build(variant, shift);
+        ok &= if variant.fidelity.family() == Family::Cube {
+            table_build(variant, shift)
+        } else {
+            inverse(variant, shift)
+        };
     }
     for &(name, scene, fidelity, table) in CONTROL_STEPS {
         ok &= control_step(name, scene, fidelity, table, shift);

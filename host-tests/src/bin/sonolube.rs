@@ -8,6 +8,11 @@ type Subcommand = (&'static str, &'static str, fn(&[String]) -> ExitCode);
 const SUBCOMMANDS: &[Subcommand] = &[
     // (subcommands register here)
     (
+        "dahl-table",
+        "write the Dahl steady-state table nodes from the f64 reference",
+        sonolube_host::cli::dahl_table::run,
+    ),
+    (
         "eval",
         "evaluate a model in fixed point and f64 (JSON)",
         sonolube_host::cli::eval::run,

@@ -52,14 +52,14 @@ use std::process::ExitCode;
 
 use crate::scene_file::LoadedScene;
 use figure::svg;
-use report::{pass, report, short};
+use report::{pass, report};
 use sonolube::scene::{SCENES, Scene};
 use sonolube_sim::{ClosedLoop, RunSummary};
 
 pub use csv::csv;
-pub use report::{model_line, model_name};
+pub use report::{model_line, model_name, short};
 
-const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml]\n       \
+const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml] [--model VARIANT]\n       \
                      sonolube scene --all [--out DIR]\n\
                      exit status: 0 every criterion passes; 1 one fails, or the scene cannot \
                      run (a file that cannot be read or is invalid, values that cannot build a \
@@ -70,19 +70,25 @@ pub fn run(args: &[String]) -> ExitCode {
     let mut name = None;
     let mut out = PathBuf::from("target/scenes");
     let mut file = None;
+    let mut forced = None;
     let mut all = false;
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
         match arg.as_str() {
             "--all" => all = true,
-            "--out" | "--file" => {
+            "--out" | "--file" | "--model" => {
                 let Some(value) = rest.next() else {
                     return usage(&format!("{arg} needs a value"));
                 };
                 if arg == "--out" {
                     out = PathBuf::from(value);
-                } else {
+                } else if arg == "--file" {
                     file = Some(PathBuf::from(value));
+                } else {
+                    match sonolube::variant::find(value) {
+                        Some(v) if v.form == sonolube::variant::Form::Fixed => forced = Some(v),
+                        _ => return usage(&format!("no fixed-point model variant '{value}'")),
+                    }
                 }
             }
             "-h" | "--help" => {
@@ -95,8 +101,8 @@ pub fn run(args: &[String]) -> ExitCode {
         }
     }
     if all {
-        if name.is_some() || file.is_some() {
-            return usage("--all takes no scene name and no --file");
+        if name.is_some() || file.is_some() || forced.is_some() {
+            return usage("--all takes no scene name, --file or --model");
         }
         return run_all(&out);
     }
@@ -122,7 +128,7 @@ pub fn run(args: &[String]) -> ExitCode {
         },
         (None, None) => return usage("a scene NAME, --file or --all is needed"),
     };
-    match run_one(&scene, &out) {
+    match run_forced(&scene, &out, forced) {
         Ok(run) => {
             print!("{}", run.report);
             exit(run.summary.passed())
@@ -197,9 +203,29 @@ pub struct SceneRun {
 }
 
 /// Runs `scene`, writes its CSV and SVG to `out`, returns the summary, the report text and
-/// the model the controller ran.
+/// the model the controller ran: the variant the host selects for it
+/// ([`crate::speed::table_rs::select_on_host`]: the firmware's choice for a built-in scene,
+/// and for a scene file one measured against the reference when the file is loaded).
 pub fn run_one(scene: &Scene<'_>, out: &Path) -> Result<SceneRun, String> {
-    let mut sim = ClosedLoop::new(scene).map_err(|e| why::cannot_run(scene, &e))?;
+    run_forced(scene, out, None)
+}
+
+/// [`run_one`], with the controller forced to run `forced` (a fixed-point model variant)
+/// instead of the selected one: `sonolube scene NAME --model VARIANT`.
+pub fn run_forced(
+    scene: &Scene<'_>,
+    out: &Path,
+    forced: Option<&sonolube::variant::Variant>,
+) -> Result<SceneRun, String> {
+    let built = match forced {
+        Some(variant) => {
+            let model = sonolube::variant::fixed::fixed_model(scene, variant)
+                .map_err(|e| format!("{}: {e}", variant.name))?;
+            ClosedLoop::with_model(scene, model)
+        }
+        None => ClosedLoop::with_selection(scene, crate::speed::table_rs::select_on_host(scene)?),
+    };
+    let mut sim = built.map_err(|e| why::cannot_run(scene, &e))?;
     let mut records = Vec::with_capacity(scene.step_count() as usize);
     while let Some(record) = sim.step() {
         records.push(record);

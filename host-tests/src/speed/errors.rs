@@ -14,7 +14,7 @@
 //! is a measurement failure, reported and not skipped silently.
 
 use sonolube::scene::{SCENES, Scene};
-use sonolube::variant::fixed::buildable;
+use sonolube::variant::fixed::{buildable, variant_buildable};
 use sonolube::variant::grid::{SceneGrid, dahl_update_inputs, littmann_inputs};
 use sonolube::variant::{CATALOGUE, Family, Fidelity, Kernel, Model, Variant};
 
@@ -160,6 +160,59 @@ fn kernel_errors(variant: &Variant) -> Result<Accumulator, String> {
     Ok(acc)
 }
 
+/// The errors of every variant of `scene`'s family against every level at or above its own
+/// that the scene carries parameters for (fixed-point variants only with `fixed_only`), over
+/// the scene's grid: the measurement
+/// [`measure`] makes for each built-in scene, and the host makes for a scene file when it is
+/// loaded (`sonolube scene --file`, [`crate::cli::scene`]). Errors: as [`measure`].
+pub fn scene_errors(
+    scene: &Scene<'_>,
+    fixed_only: bool,
+) -> Result<Vec<(&'static Variant, Accumulator, SceneErrors)>, String> {
+    let family = scene_family(scene);
+    let grid = SceneGrid::new(scene);
+    let points: Vec<_> = grid.points().collect();
+    let name: &'static str = match sonolube::scene::find(scene.name) {
+        Some(built) => built.name,
+        None => Box::leak(scene.name.to_owned().into_boxed_str()),
+    };
+    let mut out = Vec::new();
+    for &level in levels(family)
+        .iter()
+        .filter(|&&level| buildable(scene, level))
+    {
+        let exact: Vec<f64> = points
+            .iter()
+            .map(|at| reference::ratio(scene, level, at))
+            .collect::<Result<_, _>>()
+            .map_err(|e| format!("{}: reference {:?}: {e}", scene.name, level))?;
+        for variant in CATALOGUE.iter().filter(|v| {
+            v.fidelity.family() == family
+                && v.fidelity <= level
+                && variant_buildable(scene, v)
+                && (!fixed_only || v.form == sonolube::variant::Form::Fixed)
+        }) {
+            let model = Model::new(scene, variant)
+                .map_err(|e| format!("{} {}: {e}", scene.name, variant.name))?;
+            let mut acc = Accumulator::default();
+            for (at, want) in points.iter().zip(&exact) {
+                acc.add(model.ratio(at).map_or(f64::INFINITY, |got| got - want));
+            }
+            out.push((
+                variant,
+                acc,
+                SceneErrors {
+                    scene: name,
+                    variant,
+                    reference: level,
+                    stats: acc.stats(),
+                },
+            ));
+        }
+    }
+    Ok(out)
+}
+
 /// Measures every error. Errors: a reference that cannot evaluate a grid point, or a variant
 /// that cannot be built where its parameters are present (messages).
 pub fn measure() -> Result<Errors, String> {
@@ -174,37 +227,13 @@ pub fn measure() -> Result<Errors, String> {
     }
     let mut scenes = Vec::new();
     for scene in SCENES {
-        let family = scene_family(scene);
-        let grid = SceneGrid::new(scene);
-        let points: Vec<_> = grid.points().collect();
-        for &level in levels(family)
-            .iter()
-            .filter(|&&level| buildable(scene, level))
-        {
-            let exact: Vec<f64> = points
-                .iter()
-                .map(|at| reference::ratio(scene, level, at))
-                .collect::<Result<_, _>>()
-                .map_err(|e| format!("{}: reference {:?}: {e}", scene.name, level))?;
-            for (variant, own_acc) in own.iter_mut().filter(|(v, _)| {
-                v.fidelity.family() == family && v.fidelity <= level && buildable(scene, v.fidelity)
-            }) {
-                let model = Model::new(scene, variant)
-                    .map_err(|e| format!("{} {}: {e}", scene.name, variant.name))?;
-                let mut acc = Accumulator::default();
-                for (at, want) in points.iter().zip(&exact) {
-                    acc.add(model.ratio(at).map_or(f64::INFINITY, |got| got - want));
-                }
-                if variant.fidelity == level {
-                    own_acc.merge(&acc);
-                }
-                scenes.push(SceneErrors {
-                    scene: scene.name,
-                    variant,
-                    reference: level,
-                    stats: acc.stats(),
-                });
+        for (variant, acc, errors) in scene_errors(scene, false)? {
+            if variant.fidelity == errors.reference
+                && let Some((_, own_acc)) = own.iter_mut().find(|(v, _)| v.name == variant.name)
+            {
+                own_acc.merge(&acc);
             }
+            scenes.push(errors);
         }
     }
     Ok(Errors {

@@ -6,11 +6,11 @@ use std::fmt::Write as _;
 use sonolube::model::cube_table::MAX_NODES;
 use sonolube::scene::SCENES;
 use sonolube::variant::select::{Measurements, select_from};
-use sonolube::variant::{CATALOGUE, CONTROL_STEPS, Fidelity, find, grid};
+use sonolube::variant::{CATALOGUE, CONTROL_STEPS, Family, Fidelity, find, grid};
 
 use super::errors::{Errors, Stats};
 use super::fronts::{Set, Standing, is_kernel, standing};
-use super::qemu::{Counts, build_name};
+use super::qemu::{Counts, build_name, inverse_name};
 use super::table_rs::COMMAND;
 use super::timing::{SAMPLE_TIME, SAMPLES};
 
@@ -159,7 +159,10 @@ impl Report<'_> {
             s,
             "| variant | nodes | instructions to build (mean over the cube scenes) | at 170 MHz, 1 cycle per instruction | table storage |\n|---|---:|---:|---:|---|"
         );
-        for v in CATALOGUE.iter().filter(|v| v.table > 0) {
+        for v in CATALOGUE
+            .iter()
+            .filter(|v| v.table > 0 && v.fidelity.family() == Family::Cube)
+        {
             let nodes = usize::from(v.table).pow(2);
             let count = self.counts.get(&build_name(v.name));
             let _ = writeln!(
@@ -171,6 +174,33 @@ impl Report<'_> {
                 thousands(nodes as f64),
                 thousands(MAX_NODES as f64),
                 thousands(4.0 * MAX_NODES as f64),
+            );
+        }
+    }
+
+    /// The Dahl tables: storage in flash, evaluation and inverse costs, accuracy.
+    fn dahl_tables(&self, s: &mut String) {
+        let _ = writeln!(
+            s,
+            "| variant | nodes (with ghosts) | flash | instructions per evaluation | instructions per inverse | max error over the in-plane scenes (against the exact Dahl steady state) |\n|---|---:|---:|---:|---:|---:|"
+        );
+        for v in CATALOGUE
+            .iter()
+            .filter(|v| v.table > 0 && v.fidelity == Fidelity::DahlSteady)
+        {
+            let side = usize::from(v.table);
+            let padded = (side + 2).pow(2);
+            let inverse = self.counts.get(&inverse_name(v.name));
+            let _ = writeln!(
+                s,
+                "| {} | {} ({}) | {} bytes | {} | {} | {} |",
+                v.name,
+                thousands((side * side) as f64),
+                thousands(padded as f64),
+                thousands(4.0 * padded as f64),
+                self.instructions(v.name).map_or("-".into(), thousands),
+                inverse.map_or("-".into(), |c| thousands(c.instructions)),
+                self.errors.own(v.name).map_or("-".into(), |e| error(e.max)),
             );
         }
     }
@@ -201,6 +231,38 @@ impl Report<'_> {
             "| control step at the default fidelity: at most 3,000 instructions | {step:.1} | {} |",
             met(step <= 3000.0)
         );
+        // Issue 13: the Dahl steady state at loop speed.
+        let dahl = "Dahl steady T=65x65";
+        let got = self.instructions(dahl).unwrap_or(f64::INFINITY);
+        let err = self.errors.own(dahl).map_or(f64::INFINITY, |e| e.max);
+        let _ = writeln!(
+            s,
+            "| {dahl}: evaluation at most 300 instructions at max error 1e-4 over the scenes' ranges | {got:.1} instructions, max error {} | {} |",
+            error(err),
+            met(got <= 300.0 && err <= 1e-4)
+        );
+        let inverse = self
+            .counts
+            .get(&inverse_name(dahl))
+            .map_or(f64::INFINITY, |c| c.instructions);
+        let _ = writeln!(
+            s,
+            "| {dahl}: inverse at most 600 instructions | {inverse:.1} | {} |",
+            met(inverse <= 600.0)
+        );
+        let name = "control step Dahl steady T=65x65";
+        let (mean, longest) = self
+            .counts
+            .get(name)
+            .map_or((f64::INFINITY, u64::MAX), |c| {
+                (c.instructions, c.longest.unwrap_or(u64::MAX))
+            });
+        let _ = writeln!(
+            s,
+            "| {name}: at most 3,000 instructions on average, no overrun at 10 kHz at 125 M instructions/s (longest at most 12,500) | mean {mean:.1}, longest {} | {} |",
+            thousands(longest as f64),
+            met(mean <= 3000.0 && longest <= 12_500)
+        );
         let violations: Vec<String> = self
             .sets
             .iter()
@@ -225,6 +287,52 @@ impl Report<'_> {
             },
             met(violations.is_empty())
         );
+    }
+
+    /// Scene `compliant` closed loop with the selected variant and with the Coulomb ratio.
+    fn compliance(&self, s: &mut String) {
+        let Some(scene) = sonolube::scene::find("compliant") else {
+            let _ = writeln!(s, "(no scene `compliant`)");
+            return;
+        };
+        let _ = writeln!(s, "| controller model | verdicts |\n|---|---|");
+        let selected = select_from(scene, self.measured);
+        let runs = [
+            (selected.variant, "selected"),
+            (find("Coulomb ratio"), "forced"),
+        ];
+        for (variant, how) in runs {
+            let Some(variant) = variant else {
+                continue;
+            };
+            let line = sonolube::variant::fixed::fixed_model(scene, variant)
+                .map_err(|e| format!("{e}"))
+                .and_then(|model| {
+                    sonolube_sim::ClosedLoop::with_model(scene, model).map_err(|e| format!("{e:?}"))
+                })
+                .map(|mut run| {
+                    while run.step().is_some() {}
+                    let summary = run.summary();
+                    let verdicts: Vec<String> = summary
+                        .verdicts
+                        .iter()
+                        .map(|v| {
+                            format!(
+                                "{} {}",
+                                if v.passed { "PASS" } else { "FAIL" },
+                                crate::cli::scene::short(&v.criterion, v.measured)
+                            )
+                        })
+                        .collect();
+                    format!(
+                        "{}; {}",
+                        verdicts.join(", "),
+                        if summary.passed() { "PASS" } else { "FAIL" }
+                    )
+                })
+                .unwrap_or_else(|e| format!("cannot run: {e}"));
+            let _ = writeln!(s, "| {} ({how}) | {line} |", variant.name);
+        }
     }
 
     fn scenes(&self, s: &mut String) {
@@ -349,21 +457,50 @@ impl Report<'_> {
         );
         self.table_builds(&mut s);
         s.push('\n');
-        let _ = writeln!(s, "## Goals (issue 7)\n");
+        let _ = writeln!(
+            s,
+            "## Dahl tables\n\n\
+             A Dahl table variant (`Dahl steady T=SxS`, alpha = 1) interpolates F_avg / (mu W) \
+             bicubically (Catmull-Rom) in S x S nodes over x = mu_i(zeta) in [0, 1] and \
+             ln(kappa x_a) in [-8, 8], with one ghost node per side; the nodes are the \
+             independent f64 reference's, compiled into flash (`sonolube dahl-table` writes \
+             `src/model/dahl_table_nodes.rs`; nothing is built at scene start). Its inverse (the \
+             amplitude for a target ratio) follows the curve the amplitudes trace through the \
+             table at a fixed operating point (`sonolube::model::dahl_table`). The inverse is \
+             counted in QEMU as above over the in-plane scenes' grids, the target being the \
+             ratio at each grid point:\n"
+        );
+        self.dahl_tables(&mut s);
+        s.push('\n');
+        let _ = writeln!(s, "## Goals (issues 7 and 13)\n");
         self.goals(&mut s);
         let _ = writeln!(
             s,
             "\n## What each scene runs\n\n\
              A scene states the error budget of its controller model (`accuracy.model_pct`, % \
              of the natural friction) and what it contains. `sonolube::variant::select` models \
-             only what the contents need (no normal vibration: no contact re-evaluation, so no \
-             cube model; normal vibration: the cube model, with the plastic terms skipped only \
-             where the elastic contact meets the budget over the load range) and picks the \
-             cheapest fixed-point variant whose measured maximum error over the scene's grid, \
-             against the exact model of the required level, meets the budget. The table below \
-             is the firmware's choice, from `src/variant/table.rs`:\n"
+             only what the contents need and measures every cheaper candidate against the most \
+             faithful model of the scene's contact the project has (issue 13): in-plane \
+             vibration with a finite k_t, the Dahl steady state with the scene's k_t and alpha \
+             (so a stiff contact keeps the Coulomb ratio only where it is within budget of \
+             Dahl); in-plane without k_t, the Coulomb ratio; normal vibration, the \
+             elastic-plastic cube model (the plastic terms skipped only where the elastic \
+             contact meets the budget over the load range). The cheapest fixed-point variant \
+             whose measured maximum error over the scene's grid meets the budget wins; the \
+             reason names the reference. The table below is the firmware's choice, from \
+             `src/variant/table.rs`; a scene file the table did not measure is measured by the \
+             host when `sonolube scene --file` loads it:\n"
         );
         self.scenes(&mut s);
+        let _ = writeln!(
+            s,
+            "\n## What modelling the compliance buys\n\n\
+             Scene `compliant` (seed 003's own k_t = 0.056 N/um; the `reference` scene's \
+             conditions: 0.5 % FS noise, plant mu +20 %, k_t -20 %, the plant integrating the \
+             Dahl law in time) run on the host with the variant its selection picks, and with \
+             the Coulomb ratio forced (`sonolube scene compliant --model \"Coulomb ratio\"`):\n"
+        );
+        self.compliance(&mut s);
         let _ = writeln!(
             s,
             "\nPareto fronts per scene and reference level (every form competes; the \

@@ -70,6 +70,22 @@ fn parse_line(line: &str) -> Option<Result<(String, Count), String>> {
 }
 
 /// The name of a table variant's build measurement (`bench build NAME`, once per cube scene).
+/// The name of a table variant's extra count: the build of a cube table (at scene start), the
+/// inverse of a Dahl table (in flash: nothing to build).
+pub fn table_count_name(variant: &sonolube::variant::Variant) -> String {
+    if variant.fidelity.family() == sonolube::variant::Family::Cube {
+        build_name(variant.name)
+    } else {
+        inverse_name(variant.name)
+    }
+}
+
+/// The name of a Dahl table variant's inverse count (`bench inverse NAME`).
+pub fn inverse_name(variant: &str) -> String {
+    format!("inverse {variant}")
+}
+
+/// The name of a cube table variant's build count (`bench build NAME`).
 pub fn build_name(variant: &str) -> String {
     format!("build {variant}")
 }
@@ -89,7 +105,7 @@ pub fn parse(log: &str) -> Result<Counts, String> {
     let builds: Vec<String> = CATALOGUE
         .iter()
         .filter(|v| v.table > 0)
-        .map(|v| build_name(v.name))
+        .map(table_count_name)
         .collect();
     let expected = CATALOGUE
         .iter()
@@ -121,8 +137,8 @@ mod tests {
         }
         for v in CATALOGUE.iter().filter(|v| v.table > 0) {
             log.push_str(&format!(
-                "0.9 INFO  bench build {}: 356000.500 instructions per call (3 calls)\n",
-                v.name
+                "0.9 INFO  bench {}: 356000.500 instructions per call (3 calls)\n",
+                table_count_name(v)
             ));
         }
         for (name, _, _, _) in CONTROL_STEPS {

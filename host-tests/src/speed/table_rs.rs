@@ -42,6 +42,35 @@ fn scene_errors(errors: &Errors) -> Vec<SceneError> {
         .collect()
 }
 
+/// The selection for `scene` as the host makes it when it loads the scene: the firmware's
+/// ([`sonolube::variant::select`], from the committed table) for a built-in scene as measured,
+/// and otherwise from the errors of the fixed-point candidates measured now against the
+/// reference for this scene's contents ([`super::errors::scene_errors`], a few seconds at
+/// most) with the committed instruction counts. Errors: the reference's (message).
+pub fn select_on_host(
+    scene: &sonolube::scene::Scene<'_>,
+) -> Result<sonolube::variant::Selection, String> {
+    use sonolube::variant::select::{measured_as_built_in, select_from};
+    if measured_as_built_in(scene) {
+        return Ok(sonolube::variant::select(scene));
+    }
+    let errors: Vec<SceneError> = super::errors::scene_errors(scene, true)?
+        .into_iter()
+        .map(|(_, _, e)| SceneError {
+            scene: e.scene,
+            variant: e.variant.name,
+            reference: e.reference,
+            max_error: round_up(e.stats.max) as f32,
+            points: e.stats.points.min(u16::MAX as usize) as u16,
+        })
+        .collect();
+    let measured = Measurements {
+        costs: sonolube::variant::table::MEASURED.costs,
+        errors: Box::leak(errors.into_boxed_slice()),
+    };
+    Ok(select_from(scene, &measured))
+}
+
 /// The measurements of this run, as the selection sees them (leaked: a tool runs once).
 pub fn measurements(errors: &Errors, counts: &Counts) -> Measurements {
     Measurements {

@@ -230,7 +230,7 @@ pub(super) fn criterion_text(criterion: &Criterion) -> String {
 
 /// A criterion's name, measured value and limit in a few words, for the `--all` lines:
 /// `settle 1.4 ms (max 3 ms)`.
-pub(super) fn short(criterion: &Criterion, value: Measured) -> String {
+pub fn short(criterion: &Criterion, value: Measured) -> String {
     let (name, limit) = match *criterion {
         Criterion::Settle { within_s, .. } => ("settle", format!("{} ms", num(within_s * 1e3))),
         Criterion::Overshoot { max_pct } => ("overshoot", format!("{} %", num(max_pct))),
