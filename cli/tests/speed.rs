@@ -8,7 +8,7 @@ use std::process::Command;
 use sonolube::scene::SCENES;
 use sonolube::variant::grid::SceneGrid;
 use sonolube::variant::{Form, Model, select};
-use sonolube_host::speed::{self, MARKDOWN, QEMU_LOG, Run, TABLE, markdown, reference};
+use sonolube_cli::speed::{self, MARKDOWN, QEMU_LOG, Run, TABLE, markdown, reference};
 
 fn committed(path: &str) -> String {
     let full = speed::repo_root().join(path);

@@ -1,5 +1,5 @@
 //! The exact `f64` model of each level at a scene's grid point, from the independent reference
-//! ([`crate::reference`]: closed forms and converged adaptive quadrature, never the firmware's
+//! ([`sonolube_host::reference`]: closed forms and converged adaptive quadrature, never the firmware's
 //! code), with the scene's controller parameters and hardware as the variants use them
 //! ([`sonolube::variant::fixed`]).
 
@@ -9,10 +9,10 @@ use sonolube::scene::{RoughSurface, Scene};
 use sonolube::variant::Fidelity;
 use sonolube::variant::grid::{DahlUpdateInput, GridPoint};
 
-use crate::reference::contact::{ContactModel, ContactParameters, EStarRule};
-use crate::reference::coulomb::{littmann_ratio, velocity_ratio};
-use crate::reference::cube::{CubeInput, CubeOptions, SlipWindow, UPhase, cube_reduction};
-use crate::reference::dahl_models::{DahlSteadyInput, dahl_steady};
+use sonolube_host::reference::contact::{ContactModel, ContactParameters, EStarRule};
+use sonolube_host::reference::coulomb::{littmann_ratio, velocity_ratio};
+use sonolube_host::reference::cube::{CubeInput, CubeOptions, SlipWindow, UPhase, cube_reduction};
+use sonolube_host::reference::dahl_models::{DahlSteadyInput, dahl_steady};
 
 /// The reference's contact parameters for a scene surface.
 fn contact(surface: &RoughSurface) -> ContactParameters {

@@ -9,7 +9,7 @@ use std::process::Command;
 use sonolube::protocol::SupervisorState;
 use sonolube::scene::{SCENES, Scene, find};
 use sonolube::variant::{Reason, select};
-use sonolube_host::cli::scene::{model_line, model_name, run_one};
+use sonolube_cli::commands::scene::{model_line, model_name, run_one};
 use sonolube_sim::{ClosedLoop, Measured, RunSummary, StepRecord};
 
 fn run(scene: &Scene<'_>) -> (Vec<StepRecord>, RunSummary) {
@@ -278,7 +278,7 @@ fn the_command_line_reports_and_exits_as_documented() {
         "{station_line} not in the header of {text}"
     );
     assert!(out.join("reference.csv").is_file() && out.join("reference.svg").is_file());
-    let file = sonolube_host::scene_file::scenes_dir().join("sensor-fault.toml");
+    let file = sonolube_cli::scene_file::scenes_dir().join("sensor-fault.toml");
     let from_file = scene(&["--file", file.to_str().expect("utf-8"), "--out", out_dir]);
     assert_eq!(from_file.status.code(), Some(0));
     let mismatch = scene(&["reference", "--file", file.to_str().expect("utf-8")]);

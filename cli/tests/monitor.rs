@@ -22,7 +22,7 @@ use sonolube::protocol::{
     format_ack, format_error, format_faults, format_scene_list, format_status, format_telemetry,
     format_version, parse_command,
 };
-use sonolube_host::monitor::{
+use sonolube_cli::monitor::{
     AcceptanceConfig, AcceptanceReport, CSV_HEADER, Connection, Link, LinkOptions, Step, WaitClock,
     parse_script, run_acceptance, run_steps, telemetry_csv, telemetry_svg,
 };
@@ -340,7 +340,7 @@ fn acceptance(faults: Misbehaviour) -> (AcceptanceReport, String) {
         connect_timeout: Duration::from_secs(5),
         ..options()
     };
-    let endpoint = sonolube_host::monitor::Endpoint::Unix(path);
+    let endpoint = sonolube_cli::monitor::Endpoint::Unix(path);
     let mut link = Link::connect(&endpoint, link_options).expect("connect to the mock");
     let mut printed = Vec::new();
     let report = run_acceptance(&mut link, &AcceptanceConfig::default(), &mut printed);
@@ -449,7 +449,7 @@ fn acceptance_fails_on_a_seq_gap_without_lost_and_on_garbled_lines() {
 fn scripts_wait_on_firmware_time_and_record_telemetry() {
     let (path, server) = mock(Misbehaviour::default(), Duration::from_millis(300));
     // The socket appears 300 ms later: connecting retries until it does.
-    let endpoint = sonolube_host::monitor::Endpoint::Unix(path.clone());
+    let endpoint = sonolube_cli::monitor::Endpoint::Unix(path.clone());
     let mut link = Link::connect(&endpoint, options()).expect("connect after a retry");
     let steps = parse_script(
         "# telemetry is off: wall time\nwait 20\nscene reference\ntarget coef 0.2\n\

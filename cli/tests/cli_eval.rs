@@ -154,7 +154,7 @@ fn readme_paper_table_is_the_current_output_of_sonolube_papers() {
     let (block, _) = rest
         .split_once("<!-- papers:end -->")
         .expect("README has the papers:end marker");
-    let (table, _) = sonolube_host::cli::papers::table();
+    let (table, _) = sonolube_cli::commands::papers::table();
     assert_eq!(
         block, table,
         "README paper table is stale: run scripts/readme-papers"

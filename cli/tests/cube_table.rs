@@ -8,7 +8,7 @@ use sonolube::model::OperatingPoint;
 use sonolube::scene::SCENES;
 use sonolube::variant::grid::GridPoint;
 use sonolube::variant::{CATALOGUE, Model};
-use sonolube_host::speed::reference;
+use sonolube_cli::speed::reference;
 
 /// Loads and amplitudes of the dense grid (amplitudes k / 96: 1 in 3 is not a node of any
 /// table, since 96 is not a power of two).

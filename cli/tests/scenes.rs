@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use sonolube::protocol::{Target, is_scene_name};
 use sonolube::scene::{self, Criterion, ModelKind, SCENES, System, target_at};
-use sonolube_host::scene_file::{LoadedScene, out_of_reach, scenes_dir, target_ratio};
+use sonolube_cli::scene_file::{LoadedScene, out_of_reach, scenes_dir, target_ratio};
 use sonolube_sim::plant::Plant;
 
 fn loaded() -> Vec<LoadedScene> {

@@ -10,27 +10,27 @@ const SUBCOMMANDS: &[Subcommand] = &[
     (
         "eval",
         "evaluate a model in fixed point and f64 (JSON)",
-        sonolube_host::cli::eval::run,
+        sonolube_cli::commands::eval::run,
     ),
     (
         "monitor",
         "talk to the firmware: commands, telemetry CSV/SVG, acceptance test",
-        sonolube_host::cli::monitor::run,
+        sonolube_cli::commands::monitor::run,
     ),
     (
         "papers",
         "paper numbers vs reference vs fixed point (markdown)",
-        sonolube_host::cli::papers::run,
+        sonolube_cli::commands::papers::run,
     ),
     (
         "scene",
         "run a scene closed loop: CSV, SVG and metrics",
-        sonolube_host::cli::scene::run,
+        sonolube_cli::commands::scene::run,
     ),
     (
         "speed",
         "speed vs accuracy of every model variant (markdown, SVG, table)",
-        sonolube_host::cli::speed::run,
+        sonolube_cli::commands::speed::run,
     ),
 ];
 

@@ -1,6 +1,6 @@
 //! `sonolube papers`: every paper number next to the f64 reference and the fixed-point model.
 //!
-//! Prints a markdown table (the one in the README) from [`crate::papers::PAPER_CASES`]: where
+//! Prints a markdown table (the one in the README) from [`sonolube_host::papers::PAPER_CASES`]: where
 //! the number is printed, the printed value, the reference model's value, the fixed-point
 //! model's value, and whether the model reproduces the paper (with the reason when it does not).
 //! With `--check`, exits 1 if a fixed-point value differs from the reference by more than the
@@ -8,9 +8,9 @@
 
 use std::process::ExitCode;
 
-use crate::fixed_eval::eval_fixed_named;
-use crate::papers::{Agreement, PAPER_CASES, PaperCase, Tolerance};
-use crate::reference::eval_named;
+use sonolube_host::fixed_eval::eval_fixed_named;
+use sonolube_host::papers::{Agreement, PAPER_CASES, PaperCase, Tolerance};
+use sonolube_host::reference::eval_named;
 
 /// Entry point of `sonolube papers`.
 pub fn run(args: &[String]) -> ExitCode {

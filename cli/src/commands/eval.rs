@@ -21,8 +21,8 @@ use std::process::ExitCode;
 
 use serde_json::{Map, Value, json};
 
-use crate::fixed_eval::{Outputs, eval_fixed_named, models};
-use crate::reference::eval_named;
+use sonolube_host::fixed_eval::{Outputs, eval_fixed_named, models};
+use sonolube_host::reference::eval_named;
 
 /// Keys that select a variant rather than give an input.
 pub const VARIANT_KEYS: &[&str] = &[

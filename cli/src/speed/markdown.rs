@@ -431,7 +431,7 @@ the same inputs (prepared in its own number type, passed through `black_box`), p
 for at least {sample_ms} ms per sample, sampled in turn with the `f64` form of the same level and knob;
 the figure is the median of {samples} such ratios. Ratios move between runs (a few % on a quiet
 machine, up to about 20 % on a busy one: read them to one significant digit); the check
-that the committed files are current (`host-tests/tests/speed.rs`) replays the ratios of this
+that the committed files are current (`cli/tests/speed.rs`) replays the ratios of this
 file instead of timing again.
 
 **What an instruction count means on the G474.** QEMU counts instructions, not cycles, and
