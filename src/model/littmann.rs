@@ -146,6 +146,18 @@ pub fn velocity_ratio<const FV: u32>(
 /// harness, per branch: about 40 for |zeta| <= 1/2, 60 for 1/2 < |zeta| < 1 (the square
 /// root's three hardware divisions take 2-12 cycles each on the Cortex-M4) and 18 for
 /// |zeta| >= 1.
+///
+/// ```
+/// use sonolube::fx::Q2_30;
+/// use sonolube::model::littmann::mu_i;
+///
+/// // (2/pi) asin(1/2) = 1/3; beyond |zeta| = 1 the velocity never reverses: 1.
+/// let third = mu_i(Q2_30::from_ratio(1, 2)?)?;
+/// assert!((third.to_f64() - 1.0 / 3.0).abs() < 2e-9);
+/// assert_eq!(mu_i(Q2_30::from_ratio(3, 2)?)?, Q2_30::ONE);
+/// assert_eq!(mu_i(Q2_30::from_ratio(-3, 2)?)?.to_f64(), -1.0);
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
 pub fn mu_i<const F: u32>(zeta: Q<F>) -> Result<Q2_30, ModelError> {
     // |zeta| in units of 2^-F (2^31 for Q1.31's -1.0 included): |zeta| >= 1 <=> a >> F != 0.
     let a = zeta.to_bits().unsigned_abs();
