@@ -146,17 +146,17 @@ fn papers_table_has_a_row_per_case_and_the_fixed_point_agrees() {
 
 #[test]
 fn readme_paper_table_is_the_current_output_of_sonolube_papers() {
-    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md"))
-        .expect("README.md is readable");
+    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/models.md"))
+        .expect("docs/models.md is readable");
     let (_, rest) = readme
         .split_once("<!-- papers:begin -->\n")
-        .expect("README has the papers:begin marker");
+        .expect("docs/models.md has the papers:begin marker");
     let (block, _) = rest
         .split_once("<!-- papers:end -->")
-        .expect("README has the papers:end marker");
+        .expect("docs/models.md has the papers:end marker");
     let (table, _) = sonolube_cli::commands::papers::table();
     assert_eq!(
         block, table,
-        "README paper table is stale: run scripts/readme-papers"
+        "docs/models.md paper table is stale: run scripts/readme-papers"
     );
 }

@@ -1,6 +1,6 @@
 //! `sonolube papers`: every paper number next to the f64 reference and the fixed-point model.
 //!
-//! Prints a markdown table (the one in the README) from [`sonolube_host::papers::PAPER_CASES`]: where
+//! Prints a markdown table (the one in `docs/models.md`) from [`sonolube_host::papers::PAPER_CASES`]: where
 //! the number is printed, the printed value, the reference model's value, the fixed-point
 //! model's value, and whether the model reproduces the paper (with the reason when it does not).
 //! With `--check`, exits 1 if a fixed-point value differs from the reference by more than the
