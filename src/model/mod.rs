@@ -46,26 +46,46 @@
 
 use core::fmt;
 
+// One folder per model family (dahl/, cube/, contact/, coulomb/, exp_coulomb/); the modules
+// keep their flat names (`model::dahl_steady`), so every path into them is unchanged.
 pub mod actuator;
 pub mod any_model;
+#[path = "contact/contact.rs"]
 pub mod contact;
+#[path = "contact/contact_constants.rs"]
 pub mod contact_constants;
+#[path = "coulomb/coulomb.rs"]
 pub mod coulomb;
+#[path = "coulomb/coulomb_sampled.rs"]
 pub mod coulomb_sampled;
+#[path = "cube/cube.rs"]
 pub mod cube;
+#[path = "cube/cube_model.rs"]
 pub mod cube_model;
+#[path = "cube/cube_nodes.rs"]
 mod cube_nodes;
+#[path = "cube/cube_table.rs"]
 pub mod cube_table;
+#[path = "dahl/dahl.rs"]
 pub mod dahl;
+#[path = "dahl/dahl_cycle.rs"]
 pub(crate) mod dahl_cycle;
+#[path = "dahl/dahl_quadrature.rs"]
 pub(crate) mod dahl_quadrature;
+#[path = "dahl/dahl_relax.rs"]
 pub mod dahl_relax;
+#[path = "dahl/dahl_steady.rs"]
 pub mod dahl_steady;
+#[path = "dahl/dahl_travel.rs"]
 pub(crate) mod dahl_travel;
+#[path = "dahl/dahl_window.rs"]
 pub mod dahl_window;
+#[path = "exp_coulomb/exp_average.rs"]
 pub mod exp_average;
+#[path = "exp_coulomb/exp_coulomb.rs"]
 pub mod exp_coulomb;
 pub mod horn;
+#[path = "coulomb/littmann.rs"]
 pub mod littmann;
 pub mod quadrature;
 pub mod scaled;
