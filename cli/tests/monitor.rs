@@ -16,6 +16,7 @@ use std::thread::{self, JoinHandle};
 use std::time::{Duration, Instant};
 
 use heapless::String as Line;
+use sonolube::protocol::LoopReading;
 use sonolube::protocol::{
     Command, FaultReport, LineAssembler, PROTOCOL_VERSION, ProtocolError, REPLY_CAPACITY,
     StatusReport, SupervisorState, TELEMETRY_CAPACITY, Target, TelemetryRecord, VersionReport,
@@ -108,13 +109,15 @@ impl Firmware {
         TelemetryRecord {
             time_us: self.plant_us,
             seq: self.seq,
-            state: self.state,
-            target: self.target,
-            friction_coef_ppm: (self.mu * 1e6).round() as u32,
-            normal_force_mn: (NORMAL_N * 1e3) as i32,
-            tangential_force_mn: (self.mu * NORMAL_N * 1e3).round() as i32,
-            drive_amplitude_ppm: (self.amplitude * 1e6).round() as u32,
-            drive_freq_chz: self.freq_chz,
+            reading: LoopReading {
+                state: self.state,
+                target: self.target,
+                friction_coef_ppm: (self.mu * 1e6).round() as u32,
+                normal_force_mn: (NORMAL_N * 1e3) as i32,
+                tangential_force_mn: (self.mu * NORMAL_N * 1e3).round() as i32,
+                drive_amplitude_ppm: (self.amplitude * 1e6).round() as u32,
+                drive_freq_chz: self.freq_chz,
+            },
             overruns: self.overruns,
             lost_records: self.lost,
         }
@@ -190,14 +193,16 @@ impl Firmware {
             ),
             Command::Status => format_status(
                 &StatusReport {
-                    state: self.state,
+                    reading: LoopReading {
+                        state: self.state,
+                        target: self.target,
+                        friction_coef_ppm: self.record().reading.friction_coef_ppm,
+                        normal_force_mn: self.record().reading.normal_force_mn,
+                        tangential_force_mn: self.record().reading.tangential_force_mn,
+                        drive_amplitude_ppm: self.record().reading.drive_amplitude_ppm,
+                        drive_freq_chz: self.freq_chz,
+                    },
                     scene: self.scene,
-                    target: self.target,
-                    friction_coef_ppm: self.record().friction_coef_ppm,
-                    normal_force_mn: self.record().normal_force_mn,
-                    tangential_force_mn: self.record().tangential_force_mn,
-                    drive_amplitude_ppm: self.record().drive_amplitude_ppm,
-                    drive_freq_chz: self.freq_chz,
                     overruns: self.overruns,
                     lost_telemetry: self.lost,
                     latched_fault: None,
@@ -490,7 +495,11 @@ fn scripts_wait_on_firmware_time_and_record_telemetry() {
     assert!(session.anomalies.is_clean());
     let records = session.telemetry.records();
     assert!(records.len() >= 20, "{} records", records.len());
-    assert!(records.iter().any(|r| r.state == SupervisorState::Running));
+    assert!(
+        records
+            .iter()
+            .any(|r| r.reading.state == SupervisorState::Running)
+    );
     let csv = telemetry_csv(records);
     assert_eq!(csv.lines().next(), Some(CSV_HEADER));
     assert_eq!(csv.lines().count(), records.len() + 1);

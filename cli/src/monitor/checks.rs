@@ -285,7 +285,7 @@ impl<'a> Run<'a> {
         let gaps = SeqGaps::of(&records);
         let not_running = records
             .iter()
-            .filter(|r| r.state != SupervisorState::Running)
+            .filter(|r| r.reading.state != SupervisorState::Running)
             .count();
         let tel_overruns = match (records.first(), records.last()) {
             (Some(a), Some(b)) => Some((a.overruns, b.overruns)),
@@ -379,8 +379,8 @@ impl<'a> Run<'a> {
         if !drive_is_off(&record) {
             return Err(format!(
                 "still amp={} state={} {} ms after stop (limit {} ms); {status_text}",
-                fixed(i64::from(record.drive_amplitude_ppm), 6),
-                record.state.name(),
+                fixed(i64::from(record.reading.drive_amplitude_ppm), 6),
+                record.reading.state.name(),
                 fixed(
                     i64::try_from(record.time_us.saturating_sub(stop_us)).unwrap_or(0),
                     3
@@ -390,7 +390,7 @@ impl<'a> Run<'a> {
         }
         let measured = format!(
             "amp 0 and state {} {} ms after stop (limit {} ms); {status_text}",
-            record.state.name(),
+            record.reading.state.name(),
             fixed(
                 i64::try_from(record.time_us.saturating_sub(stop_us)).unwrap_or(0),
                 3

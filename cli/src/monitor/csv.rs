@@ -35,13 +35,13 @@ pub fn telemetry_csv(records: &[TelemetryRecord]) -> String {
             "{},{},{},{},{},{},{},{},{},{},{}",
             r.time_us,
             r.seq,
-            r.state.name(),
-            target_text(r.target.as_ref()),
-            fixed(i64::from(r.friction_coef_ppm), 6),
-            fixed(i64::from(r.normal_force_mn), 3),
-            fixed(i64::from(r.tangential_force_mn), 3),
-            fixed(i64::from(r.drive_amplitude_ppm), 6),
-            fixed(i64::from(r.drive_freq_chz), 2),
+            r.reading.state.name(),
+            target_text(r.reading.target.as_ref()),
+            fixed(i64::from(r.reading.friction_coef_ppm), 6),
+            fixed(i64::from(r.reading.normal_force_mn), 3),
+            fixed(i64::from(r.reading.tangential_force_mn), 3),
+            fixed(i64::from(r.reading.drive_amplitude_ppm), 6),
+            fixed(i64::from(r.reading.drive_freq_chz), 2),
             r.overruns,
             r.lost_records,
         );
@@ -52,6 +52,7 @@ pub fn telemetry_csv(records: &[TelemetryRecord]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sonolube::protocol::LoopReading;
     use sonolube::protocol::{SupervisorState, Target, format_telemetry};
 
     #[test]
@@ -59,13 +60,15 @@ mod tests {
         let record = TelemetryRecord {
             time_us: 1_250_000,
             seq: 12_500,
-            state: SupervisorState::Running,
-            target: Some(Target::Coef { coef_ppm: 150_000 }),
-            friction_coef_ppm: 151_000,
-            normal_force_mn: 40_000,
-            tangential_force_mn: -6_040,
-            drive_amplitude_ppm: 523_000,
-            drive_freq_chz: 4_000_000,
+            reading: LoopReading {
+                state: SupervisorState::Running,
+                target: Some(Target::Coef { coef_ppm: 150_000 }),
+                friction_coef_ppm: 151_000,
+                normal_force_mn: 40_000,
+                tangential_force_mn: -6_040,
+                drive_amplitude_ppm: 523_000,
+                drive_freq_chz: 4_000_000,
+            },
             overruns: 0,
             lost_records: 3,
         };

@@ -15,22 +15,22 @@ pub fn telemetry_svg(title: &str, records: &[TelemetryRecord], band_pct: Option<
     let column =
         |f: &dyn Fn(&TelemetryRecord) -> f64| -> Vec<f64> { records.iter().map(f).collect() };
     let t = column(&|r| r.time_us as f64 * 1e-6);
-    let mu = column(&|r| f64::from(r.friction_coef_ppm) * 1e-6);
+    let mu = column(&|r| f64::from(r.reading.friction_coef_ppm) * 1e-6);
     // Targets of the other kinds have no value in this panel's unit: NaN breaks the line.
-    let coef_target = column(&|r| match r.target {
+    let coef_target = column(&|r| match r.reading.target {
         Some(Target::Coef { coef_ppm }) => f64::from(coef_ppm) * 1e-6,
         _ => f64::NAN,
     });
-    let force_target = column(&|r| match r.target {
+    let force_target = column(&|r| match r.reading.target {
         Some(Target::Force { force_mn }) => f64::from(force_mn) * 1e-3,
         _ => f64::NAN,
     });
-    let normal = column(&|r| f64::from(r.normal_force_mn) * 1e-3);
-    let tangential = column(&|r| f64::from(r.tangential_force_mn) * 1e-3);
-    let amplitude = column(&|r| f64::from(r.drive_amplitude_ppm) * 1e-6);
+    let normal = column(&|r| f64::from(r.reading.normal_force_mn) * 1e-3);
+    let tangential = column(&|r| f64::from(r.reading.tangential_force_mn) * 1e-3);
+    let amplitude = column(&|r| f64::from(r.reading.drive_amplitude_ppm) * 1e-6);
     let reductions = records
         .iter()
-        .filter(|r| matches!(r.target, Some(Target::Reduction { .. })))
+        .filter(|r| matches!(r.reading.target, Some(Target::Reduction { .. })))
         .count();
 
     let band_label = band_pct.map(|pct| format!("target ±{pct} %"));
@@ -64,11 +64,11 @@ pub fn telemetry_svg(title: &str, records: &[TelemetryRecord], band_pct: Option<
         .panel(forces);
     let changes = records
         .windows(2)
-        .filter(|pair| pair[0].state != pair[1].state)
+        .filter(|pair| pair[0].reading.state != pair[1].reading.state)
         .take(MAX_STATE_MARKERS);
     for pair in changes {
         let at = pair[1].time_us as f64 * 1e-6;
-        plot = plot.marker(Marker::new(pair[1].state.name(), at).color("#0072b2"));
+        plot = plot.marker(Marker::new(pair[1].reading.state.name(), at).color("#0072b2"));
     }
     plot.to_svg()
 }
@@ -76,19 +76,22 @@ pub fn telemetry_svg(title: &str, records: &[TelemetryRecord], band_pct: Option<
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sonolube::protocol::LoopReading;
     use sonolube::protocol::SupervisorState;
 
     fn record(seq: u32, state: SupervisorState, target: Option<Target>) -> TelemetryRecord {
         TelemetryRecord {
             time_us: u64::from(seq) * 1000,
             seq,
-            state,
-            target,
-            friction_coef_ppm: 240_000 - 100 * seq,
-            normal_force_mn: 40_000,
-            tangential_force_mn: 9_600,
-            drive_amplitude_ppm: 1000 * seq,
-            drive_freq_chz: 4_000_000,
+            reading: LoopReading {
+                state,
+                target,
+                friction_coef_ppm: 240_000 - 100 * seq,
+                normal_force_mn: 40_000,
+                tangential_force_mn: 9_600,
+                drive_amplitude_ppm: 1000 * seq,
+                drive_freq_chz: 4_000_000,
+            },
             overruns: 0,
             lost_records: 0,
         }

@@ -121,19 +121,22 @@ impl TelemetryLog {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sonolube::protocol::LoopReading;
     use sonolube::protocol::SupervisorState;
 
     fn record(seq: u32, lost: u32) -> TelemetryRecord {
         TelemetryRecord {
             time_us: u64::from(seq) * 1000,
             seq,
-            state: SupervisorState::Running,
-            target: None,
-            friction_coef_ppm: 0,
-            normal_force_mn: 0,
-            tangential_force_mn: 0,
-            drive_amplitude_ppm: 0,
-            drive_freq_chz: 0,
+            reading: LoopReading {
+                state: SupervisorState::Running,
+                target: None,
+                friction_coef_ppm: 0,
+                normal_force_mn: 0,
+                tangential_force_mn: 0,
+                drive_amplitude_ppm: 0,
+                drive_freq_chz: 0,
+            },
             overruns: 0,
             lost_records: lost,
         }

@@ -42,7 +42,7 @@ impl Convergence {
 
 fn error_pct(record: &TelemetryRecord, target_ppm: u32) -> f64 {
     let target = f64::from(target_ppm.max(1));
-    100.0 * (f64::from(record.friction_coef_ppm) - target).abs() / target
+    100.0 * (f64::from(record.reading.friction_coef_ppm) - target).abs() / target
 }
 
 /// Judges `records` (those after `start`, sent at firmware time `start_us`) against a
@@ -55,7 +55,7 @@ pub fn convergence(
     last: usize,
 ) -> Convergence {
     let in_band = |r: &TelemetryRecord| {
-        r.state == SupervisorState::Running && error_pct(r, target_ppm) <= tolerance_pct
+        r.reading.state == SupervisorState::Running && error_pct(r, target_ppm) <= tolerance_pct
     };
     let settled_from = records
         .iter()
@@ -79,29 +79,29 @@ pub fn convergence(
         mu_range_ppm: (
             judged
                 .iter()
-                .map(|r| r.friction_coef_ppm)
+                .map(|r| r.reading.friction_coef_ppm)
                 .min()
                 .unwrap_or(0),
             judged
                 .iter()
-                .map(|r| r.friction_coef_ppm)
+                .map(|r| r.reading.friction_coef_ppm)
                 .max()
                 .unwrap_or(0),
         ),
         not_running: judged
             .iter()
-            .filter(|r| r.state != SupervisorState::Running)
+            .filter(|r| r.reading.state != SupervisorState::Running)
             .count(),
-        wrong_target: judged.iter().filter(|r| r.target != wanted).count(),
+        wrong_target: judged.iter().filter(|r| r.reading.target != wanted).count(),
     }
 }
 
 /// Whether a record shows the drive off after `stop`: amplitude 0 and the loop no longer
 /// running or ramping up.
 pub fn drive_is_off(record: &TelemetryRecord) -> bool {
-    record.drive_amplitude_ppm == 0
+    record.reading.drive_amplitude_ppm == 0
         && !matches!(
-            record.state,
+            record.reading.state,
             SupervisorState::Running | SupervisorState::RampUp
         )
 }
@@ -188,19 +188,22 @@ impl FloodTally {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sonolube::protocol::LoopReading;
     use sonolube::protocol::ProtocolError;
 
     fn record(time_ms: u64, mu_ppm: u32, state: SupervisorState) -> TelemetryRecord {
         TelemetryRecord {
             time_us: time_ms * 1000,
             seq: time_ms as u32,
-            state,
-            target: Some(Target::Coef { coef_ppm: 150_000 }),
-            friction_coef_ppm: mu_ppm,
-            normal_force_mn: 40_000,
-            tangential_force_mn: 6_000,
-            drive_amplitude_ppm: 500_000,
-            drive_freq_chz: 4_000_000,
+            reading: LoopReading {
+                state,
+                target: Some(Target::Coef { coef_ppm: 150_000 }),
+                friction_coef_ppm: mu_ppm,
+                normal_force_mn: 40_000,
+                tangential_force_mn: 6_000,
+                drive_amplitude_ppm: 500_000,
+                drive_freq_chz: 4_000_000,
+            },
             overruns: 0,
             lost_records: 0,
         }
@@ -231,13 +234,13 @@ mod tests {
     #[test]
     fn a_late_excursion_or_wrong_state_fails() {
         let mut records = approach(200, 3.0);
-        records[190].friction_coef_ppm = 160_000;
+        records[190].reading.friction_coef_ppm = 160_000;
         let c = convergence(&records, 1_000_000, 150_000, 3.0, 50);
         assert_eq!(c.settled_after_us, Some(192_000));
         assert!(c.max_error_pct > 6.0);
         assert!(!c.passed(50, 3.0, 50_000));
         let mut records = approach(200, 3.0);
-        records[199].state = SupervisorState::Fault;
+        records[199].reading.state = SupervisorState::Fault;
         let c = convergence(&records, 1_000_000, 150_000, 3.0, 50);
         assert_eq!((c.settled_after_us, c.not_running), (None, 1));
         let c = convergence(&[], 0, 150_000, 3.0, 50);
@@ -249,9 +252,9 @@ mod tests {
     fn the_drive_is_off_only_at_zero_amplitude_out_of_the_loop() {
         let mut r = record(1, 150_000, SupervisorState::Idle);
         assert!(!drive_is_off(&r));
-        r.drive_amplitude_ppm = 0;
+        r.reading.drive_amplitude_ppm = 0;
         assert!(drive_is_off(&r));
-        r.state = SupervisorState::Running;
+        r.reading.state = SupervisorState::Running;
         assert!(!drive_is_off(&r));
     }
 
