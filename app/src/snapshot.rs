@@ -3,27 +3,15 @@
 
 use sonolube::control::Output;
 use sonolube::fx::{Q1_31, Q2_30, Q16_16};
-use sonolube::protocol::{StatusReport, SupervisorState, Target, TelemetryRecord};
+use sonolube::protocol::{LoopReading, StatusReport, Target, TelemetryRecord};
 
 /// The loop after a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, defmt::Format)]
 pub struct Snapshot {
-    /// Supervisor state.
-    pub state: SupervisorState,
+    /// State, target, friction estimate and drive: what `status` and telemetry share.
+    pub reading: LoopReading,
     /// The scene in use (a protocol word).
     pub scene: Option<&'static str>,
-    /// Friction target, if set.
-    pub target: Option<Target>,
-    /// Friction coefficient estimate, ppm.
-    pub friction_coef_ppm: u32,
-    /// Filtered normal force, mN.
-    pub normal_force_mn: i32,
-    /// Filtered tangential force, mN.
-    pub tangential_force_mn: i32,
-    /// Drive amplitude command, ppm of full scale.
-    pub drive_amplitude_ppm: u32,
-    /// Drive frequency, cHz.
-    pub drive_freq_chz: u32,
     /// The latched fault's name, if any.
     pub latched_fault: Option<&'static str>,
     /// A sensor fault found in this step's sample (its name), if any.
@@ -36,14 +24,8 @@ pub struct Snapshot {
 impl Snapshot {
     /// The snapshot before the first step.
     pub const BOOT: Snapshot = Snapshot {
-        state: SupervisorState::Boot,
+        reading: LoopReading::BOOT,
         scene: None,
-        target: None,
-        friction_coef_ppm: 0,
-        normal_force_mn: 0,
-        tangential_force_mn: 0,
-        drive_amplitude_ppm: 0,
-        drive_freq_chz: 0,
         latched_fault: None,
         active_fault: None,
         control_cycles: 0,
@@ -59,14 +41,16 @@ impl Snapshot {
         control_cycles: u32,
     ) -> Self {
         Snapshot {
-            state: output.state,
+            reading: LoopReading {
+                state: output.state,
+                target,
+                friction_coef_ppm: coefficient_ppm(output.estimate.coefficient),
+                normal_force_mn: newtons_to_mn(output.estimate.normal_force),
+                tangential_force_mn: newtons_to_mn(output.estimate.tangential_force),
+                drive_amplitude_ppm: amplitude_ppm(output.amplitude),
+                drive_freq_chz,
+            },
             scene: Some(scene),
-            target,
-            friction_coef_ppm: coefficient_ppm(output.estimate.coefficient),
-            normal_force_mn: newtons_to_mn(output.estimate.normal_force),
-            tangential_force_mn: newtons_to_mn(output.estimate.tangential_force),
-            drive_amplitude_ppm: amplitude_ppm(output.amplitude),
-            drive_freq_chz,
             latched_fault: output.fault.map(|reason| reason.name()),
             active_fault,
             control_cycles,
@@ -76,14 +60,8 @@ impl Snapshot {
     /// The `status` reply's data, with the loop's counters.
     pub fn status(&self, overruns: u32, lost_telemetry: u32) -> StatusReport {
         StatusReport {
-            state: self.state,
+            reading: self.reading,
             scene: self.scene,
-            target: self.target,
-            friction_coef_ppm: self.friction_coef_ppm,
-            normal_force_mn: self.normal_force_mn,
-            tangential_force_mn: self.tangential_force_mn,
-            drive_amplitude_ppm: self.drive_amplitude_ppm,
-            drive_freq_chz: self.drive_freq_chz,
             overruns,
             lost_telemetry,
             latched_fault: self.latched_fault,
@@ -95,13 +73,7 @@ impl Snapshot {
         TelemetryRecord {
             time_us,
             seq,
-            state: self.state,
-            target: self.target,
-            friction_coef_ppm: self.friction_coef_ppm,
-            normal_force_mn: self.normal_force_mn,
-            tangential_force_mn: self.tangential_force_mn,
-            drive_amplitude_ppm: self.drive_amplitude_ppm,
-            drive_freq_chz: self.drive_freq_chz,
+            reading: self.reading,
             overruns,
             lost_records: lost,
         }

@@ -1,4 +1,4 @@
-//! `src/model/dahl_table_nodes.rs`: the nodes of the firmware's Dahl steady-state tables
+//! `src/model/dahl/dahl_table_nodes.rs`: the nodes of the firmware's Dahl steady-state tables
 //! (`sonolube::model::dahl_table`), from the independent f64 reference
 //! ([`crate::reference::dahl_models::dahl_steady`]), as Rust source.
 //!
@@ -17,7 +17,7 @@ use sonolube::model::dahl_table::{LN_KXA_MAX, LN_KXA_MIN};
 use crate::reference::dahl_models::{DahlSteadyInput, dahl_steady};
 
 /// Path of the generated file, relative to the repository root.
-pub const PATH: &str = "src/model/dahl_table_nodes.rs";
+pub const PATH: &str = "src/model/dahl/dahl_table_nodes.rs";
 
 /// Table sides written to the file.
 pub const SIDES: [usize; 2] = [33, 65];

@@ -98,26 +98,11 @@
 //! or load ramps down to zero and restarts when the contact returns. Commands return
 //! [`ControlError`], which maps to the protocol's codes 21-23 (and 6 for a bad target).
 //!
-//! # Numbers (the test plant with the [`Settings::REFERENCE`] baseline,
-//! `cargo test -p sonolube --lib control::closed_loop -- --nocapture`)
+//! # Numbers
 //!
-//! Littmann plant and model, 40 N, 0.038 m/s, 0.8 ms envelope lag, 10 kHz; plant amplitude
-//! scale and scene `mu` each off by ±20 % (all four corners); target step 100 % → 50 % of
-//! natural friction after 100 ms at natural friction:
-//! - no noise: settling to ±2 % in 1.1-2.9 ms (1.6 ms without mismatch), overshoot ≤ 3.6 % of
-//!   the step, residual error 0.13 % (the prior's share of the learned `mu0`);
-//! - 0.5 % full-scale noise (normal cell 300 N, tangential 25 N; 3 seeds): RMS error from 3 ms on
-//!   0.22-0.63 % of the target, overshoot ≤ 4.2 %;
-//! - load ramp 40 → 240 N in 1 s, coefficient target, model error drifting from -20 % to +20 %:
-//!   largest error 0.57 % without noise; with noise (tangential cell 100 N, so 8 % of the target
-//!   friction per sample at 40 N) mean -0.47 %, RMS 0.6 %, largest 1.9 % above 60 N but up to
-//!   3 % at 40-60 N, where the noise is that large.
-//!
-//! Cost on the Cortex-M4 (QEMU mps2-an386 with `-icount`, opt-level "s", fat LTO): about 1100
-//! instructions per running step for the controller alone (the step calls the model twice:
-//! `ratio` once for the prediction and `invert` once), 2760 with a closed-form Littmann model
-//! that divides three times; a model must therefore stay within about 1900 instructions for its
-//! `ratio` and `invert` together (a 16-step bisection inversion needs a cheap `ratio`).
+//! The controller on the test plant (settling, overshoot, noise, load ramp) and its cost on the
+//! Cortex-M4, with the commands that measure them: `docs/control-and-scenes.md`, "The
+//! controller on the test plant".
 
 mod config;
 mod controller;

@@ -64,6 +64,44 @@
 //!   [`Q::ln`] or [`ln_scaled`] into Q6.26 and carry `ln K_F` precomputed, never `K_F`.
 //! - Cube model (§4): phases as `u32` turn fractions (`k * 2^31 / n` for a half period),
 //!   [`sin_cos`] per point, weights `exp_neg` of `2 lambda v / R_q` in Q16.16 or Q8.24.
+//!
+//! # Example
+//!
+//! Formats in the type, checked and saturating arithmetic, and the elementary functions
+//! (`no_std` code; `cargo test --doc -p sonolube` runs it on the host):
+//!
+//! ```
+//! use sonolube::fx::{FxError, Q1_31, Q2_30, Q8_24, Q16_16, sin_cos};
+//!
+//! // 40 N at half the ratio: a Q16.16 times a Q2.30, the result in Q16.16, rounded.
+//! let load = Q16_16::from_f64(40.0)?;
+//! let half = Q2_30::from_ratio(1, 2)?;
+//! let product: Q16_16 = load.checked_mul_to(half)?;
+//! assert_eq!(product.to_f64(), 20.0);
+//!
+//! // Out of range is an error or a flagged saturation, never a wrap.
+//! assert_eq!(Q16_16::from_f64(40_000.0), Err(FxError::Overflow));
+//! let clamped = Q16_16::from_f64_saturating(40_000.0);
+//! assert!(clamped.saturated && clamped.value == Q16_16::MAX);
+//! assert!(Q2_30::ONE.checked_add(Q2_30::ONE).is_err());
+//!
+//! // e^-1 in Q2.30, within 1 ulp of f64.
+//! let decay = Q8_24::ONE.exp_neg()?;
+//! assert!((decay.to_f64() - 0.367_879_441_171_442_3).abs() < 2e-9);
+//!
+//! // sqrt(2) and ln(2), each within an ulp of its format.
+//! let two = Q8_24::from_int(2)?;
+//! assert!((two.sqrt()?.to_f64() - core::f64::consts::SQRT_2).abs() < 1e-7);
+//! let ln2: Q2_30 = two.ln()?;
+//! assert!((ln2.to_f64() - core::f64::consts::LN_2).abs() < 2e-9);
+//!
+//! // Phases are u32 fractions of a turn: 2^29 is an eighth, 45 degrees.
+//! let (sin, cos) = sin_cos(1 << 29);
+//! assert!((sin.to_f64() - core::f64::consts::FRAC_1_SQRT_2).abs() < 1e-9);
+//! assert!((cos.to_f64() - sin.to_f64()).abs() < 1e-9);
+//! assert!(Q1_31::MAX.to_f64() < 1.0); // +1.0 is not a Q1.31
+//! # Ok::<(), FxError>(())
+//! ```
 
 mod asin;
 mod convert;
@@ -83,3 +121,6 @@ pub use ln::ln_scaled;
 pub use q::{Q, Q1_31, Q2_30, Q3_29, Q5_27, Q6_26, Q8_24, Q16_16};
 pub use sqrt::isqrt_u64;
 pub use trig::{cos, sin, sin_cos};
+
+/// The 64-bit helpers the rest of the core shares (one definition each).
+pub(crate) use raw::{div_round_i64, mul_hi_round};

@@ -135,15 +135,56 @@ pub(crate) const fn mul_hi(a: i32, b: i32) -> i32 {
     ((a as i64 * b as i64) >> 32) as i32
 }
 
-/// `round(a * b / 2^32)`, ties toward +infinity: `SMMULR` on Cortex-M4.
+/// `round(a * b / 2^32)`, ties toward +infinity: `SMMULR` on Cortex-M4. Always fits `i32`
+/// (`|a b| <= 2^62`).
 #[inline(always)]
 pub(crate) const fn mul_hi_round(a: i32, b: i32) -> i32 {
     ((a as i64 * b as i64 + (1 << 31)) >> 32) as i32
 }
 
+/// `numerator / denominator` in `i64`, rounded to nearest (ties away from zero); 0 for
+/// `denominator == 0` or `i64::MIN / -1`. Callers keep `|numerator| < 2^63 - |denominator|`
+/// (beyond it the rounding bias saturates). Uses the runtime's 64-bit division.
+pub(crate) const fn div_round_i64(numerator: i64, denominator: i64) -> i64 {
+    let half = denominator.unsigned_abs() as i64 / 2;
+    let biased = if (numerator < 0) == (denominator < 0) {
+        numerator.saturating_add(if numerator < 0 { -half } else { half })
+    } else {
+        numerator.saturating_sub(if numerator < 0 { half } else { -half })
+    };
+    match biased.checked_div(denominator) {
+        Some(quotient) => quotient,
+        None => 0,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rounding_division_rounds_half_away_from_zero_in_every_quadrant() {
+        assert_eq!(div_round_i64(7, 2), 4);
+        assert_eq!(div_round_i64(-7, 2), -4);
+        assert_eq!(div_round_i64(7, -2), -4);
+        assert_eq!(div_round_i64(-7, -2), 4);
+        assert_eq!(div_round_i64(5, 3), 2);
+        assert_eq!(div_round_i64(4, 3), 1);
+        assert_eq!(div_round_i64(1, 0), 0);
+        assert_eq!(div_round_i64(i64::MIN, -1), 0);
+        // The extremes the callers reach: 2^62 over the smallest and largest divisors.
+        assert_eq!(div_round_i64(1 << 62, 3), ((1i64 << 62) + 1) / 3);
+        assert_eq!(div_round_i64(-(1 << 62), i64::MAX), -1);
+    }
+
+    #[test]
+    fn the_rounded_high_word_always_fits_i32() {
+        assert_eq!(mul_hi_round(i32::MIN, i32::MIN), 1 << 30);
+        assert_eq!(mul_hi_round(i32::MAX, i32::MIN), -(1 << 30) + 1);
+        // 2^31 / 2^32 = 1/2 rounds up; -2^30 / 2^32 = -1/4 rounds to 0.
+        assert_eq!(mul_hi_round(1 << 15, 1 << 16), 1);
+        assert_eq!(mul_hi_round(-1, 1 << 30), 0);
+    }
 
     #[test]
     fn shr_round_matches_float_rounding_at_the_extremes() {

@@ -33,6 +33,36 @@ pub const DAHL_QUADRATURE_POINTS: u32 = 64;
 /// (1,156 bytes, whatever the table size: [`crate::model::cube_table`]), which makes the enum
 /// about 2.2 KB (a test pins it); there is no heap to box it into, and a plant or
 /// controller holds one model.
+///
+/// ```
+/// use sonolube::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
+/// use sonolube::model::{AnyModel, FrictionModel, OperatingPoint};
+///
+/// // The reference scene's plant: a Dahl contact (mu 0.24, k_t 2e7 N/m) at 40 kHz.
+/// let scene = sonolube::scene::find("reference").expect("built in");
+/// let plant = AnyModel::new(scene, &scene.plant)?;
+/// assert_eq!(plant.kind(), scene.plant.kind);
+/// let point = OperatingPoint {
+///     normal_force: Q16_16::from_f64(4.155)?,
+///     sliding_velocity: Q8_24::from_f64(0.038)?,
+/// };
+/// assert_eq!(plant.ratio(&point, Q1_31::ZERO)?, Q2_30::ONE);
+/// // The f64 reference (host-tests) gives 0.214808 at full amplitude.
+/// let full = plant.ratio(&point, Q1_31::MAX)?.to_f64();
+/// assert!((full - 0.214_808).abs() < 5e-4, "{full}");
+///
+/// // The load-ramp scene's plant: the elastic-plastic cube model (Al horn on SS, 40 N),
+/// // 0.4806 in the reference at 0.005 m/s and full amplitude.
+/// let horn = sonolube::scene::find("load-ramp").expect("built in");
+/// let cube = AnyModel::new(horn, &horn.plant)?;
+/// let point = OperatingPoint {
+///     normal_force: Q16_16::from_f64(40.0)?,
+///     sliding_velocity: Q8_24::from_f64(0.005)?,
+/// };
+/// let full = cube.ratio(&point, Q1_31::MAX)?.to_f64();
+/// assert!((full - 0.4806).abs() < 2e-3, "{full}");
+/// # Ok::<(), Box<dyn core::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[allow(clippy::large_enum_variant)]
 pub enum AnyModel {

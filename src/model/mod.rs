@@ -9,32 +9,88 @@
 //!
 //! Inputs outside a model's validity give a [`ModelError`] or a documented, flagged saturation,
 //! never a panic, a wrap or a NaN.
+//!
+//! # Example
+//!
+//! The Coulomb model of seed 003 (mu 0.3, 40 kHz, 0.3 um full-scale amplitude: v_a,max =
+//! 2 pi f x_a = 0.0754 m/s) at half that sliding speed: zeta = 1/2 at full amplitude, where
+//! the Littmann law gives F'/F = (2/pi) asin(1/2) = 1/3. Inverting it gives the amplitude for
+//! a target ratio.
+//!
+//! ```
+//! use sonolube::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
+//! use sonolube::model::coulomb::{CoulombConstants, CoulombModel};
+//! use sonolube::model::{FrictionModel, OperatingPoint, Reach};
+//!
+//! let model = CoulombModel {
+//!     constants: CoulombConstants::new(0.3, 40_000.0, 0.3e-6)?,
+//! };
+//! let v_a_max = core::f64::consts::TAU * 40_000.0 * 0.3e-6;
+//! let point = OperatingPoint {
+//!     normal_force: Q16_16::from_f64(10.0)?,
+//!     sliding_velocity: Q8_24::from_f64(0.5 * v_a_max)?,
+//! };
+//! // No vibration: the natural friction, exactly.
+//! assert_eq!(model.ratio(&point, Q1_31::ZERO)?, Q2_30::ONE);
+//! // Full amplitude: 1/3 (the velocity's Q8.24 rounding moves it by 1e-7).
+//! let full = model.ratio(&point, Q1_31::MAX)?.to_f64();
+//! assert!((full - 1.0 / 3.0).abs() < 1e-6, "{full}");
+//! // Half the friction is reachable; a fifth is not (below 1/3): full drive, flagged.
+//! let half = model.invert(&point, Q2_30::from_ratio(1, 2)?)?;
+//! assert_eq!(half.reach, Reach::Reached);
+//! assert!((half.ratio.to_f64() - 0.5).abs() < 1e-4);
+//! let fifth = model.invert(&point, Q2_30::from_ratio(1, 5)?)?;
+//! assert_eq!(fifth.reach, Reach::BelowMinimum);
+//! # Ok::<(), Box<dyn core::error::Error>>(())
+//! ```
 
 use core::fmt;
 
+// One folder per model family (dahl/, cube/, contact/, coulomb/, exp_coulomb/); the modules
+// keep their flat names (`model::dahl_steady`), so every path into them is unchanged.
 pub mod actuator;
 pub mod any_model;
+#[path = "contact/contact.rs"]
 pub mod contact;
+#[path = "contact/contact_constants.rs"]
 pub mod contact_constants;
+#[path = "coulomb/coulomb.rs"]
 pub mod coulomb;
+#[path = "coulomb/coulomb_sampled.rs"]
 pub mod coulomb_sampled;
+#[path = "cube/cube.rs"]
 pub mod cube;
+#[path = "cube/cube_model.rs"]
 pub mod cube_model;
+#[path = "cube/cube_nodes.rs"]
 mod cube_nodes;
+#[path = "cube/cube_table.rs"]
 pub mod cube_table;
+#[path = "dahl/dahl.rs"]
 pub mod dahl;
+#[path = "dahl/dahl_table.rs"]
 pub mod dahl_table;
+#[path = "dahl/dahl_table_nodes.rs"]
 #[rustfmt::skip]
 pub mod dahl_table_nodes;
+#[path = "dahl/dahl_cycle.rs"]
 pub(crate) mod dahl_cycle;
+#[path = "dahl/dahl_quadrature.rs"]
 pub(crate) mod dahl_quadrature;
+#[path = "dahl/dahl_relax.rs"]
 pub mod dahl_relax;
+#[path = "dahl/dahl_steady.rs"]
 pub mod dahl_steady;
+#[path = "dahl/dahl_travel.rs"]
 pub(crate) mod dahl_travel;
+#[path = "dahl/dahl_window.rs"]
 pub mod dahl_window;
+#[path = "exp_coulomb/exp_average.rs"]
 pub mod exp_average;
+#[path = "exp_coulomb/exp_coulomb.rs"]
 pub mod exp_coulomb;
 pub mod horn;
+#[path = "coulomb/littmann.rs"]
 pub mod littmann;
 pub mod quadrature;
 pub mod scaled;

@@ -148,6 +148,7 @@ mod name;
 mod number;
 mod parse;
 mod quantity;
+mod reading;
 mod reply;
 mod report;
 mod state;
@@ -173,6 +174,7 @@ pub use quantity::{
     ALL_QUANTITIES, CAL_LOAD, DRIVE_FREQ, Quantity, TARGET_COEF, TARGET_FORCE, TARGET_REDUCTION,
     TELEMETRY_RATE,
 };
+pub use reading::LoopReading;
 pub use reply::{NONE, OkReply, REPLY_CAPACITY, format_ack, format_error};
 pub use report::{
     FaultReport, StatusReport, VersionReport, format_faults, format_help, format_scene_list,

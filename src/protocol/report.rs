@@ -7,31 +7,18 @@
 use heapless::string::StringView;
 
 use super::command::KEYWORDS;
+use super::reading::LoopReading;
 use super::reply::{NONE, OkReply};
-use super::state::SupervisorState;
-use super::target::Target;
 use super::text::FormatError;
 
 /// The data of a `status` reply. Counters saturate at `u32::MAX` in the firmware.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct StatusReport {
-    /// Supervisor state.
-    pub state: SupervisorState,
+    /// State, target, friction estimate and drive.
+    pub reading: LoopReading,
     /// Selected scene (a word), if any.
     pub scene: Option<&'static str>,
-    /// Friction target, if set.
-    pub target: Option<Target>,
-    /// Friction coefficient estimate in ppm (1e-6), full `u32` range.
-    pub friction_coef_ppm: u32,
-    /// Normal force in mN, full `i32` range (±2147483.647 N).
-    pub normal_force_mn: i32,
-    /// Tangential (friction) force in mN, full `i32` range.
-    pub tangential_force_mn: i32,
-    /// Drive amplitude in ppm of full scale (1_000_000 = full scale).
-    pub drive_amplitude_ppm: u32,
-    /// Drive frequency in cHz (0.01 Hz).
-    pub drive_freq_chz: u32,
     /// Control-loop overruns since boot.
     pub overruns: u32,
     /// Telemetry records dropped because the UART was busy, since boot.
@@ -66,14 +53,18 @@ pub struct VersionReport {
 /// `ok state= scene= target= mu= normal_n= tangential_n= amp= freq_hz= overruns= lost= fault=`.
 pub fn format_status(report: &StatusReport, out: &mut StringView) -> Result<(), FormatError> {
     OkReply::new(out)
-        .word("state", report.state.name())
+        .word("state", report.reading.state.name())
         .word("scene", report.scene.unwrap_or(NONE))
-        .target("target", report.target.as_ref())
-        .fixed("mu", i64::from(report.friction_coef_ppm), 6)
-        .fixed("normal_n", i64::from(report.normal_force_mn), 3)
-        .fixed("tangential_n", i64::from(report.tangential_force_mn), 3)
-        .fixed("amp", i64::from(report.drive_amplitude_ppm), 6)
-        .fixed("freq_hz", i64::from(report.drive_freq_chz), 2)
+        .target("target", report.reading.target.as_ref())
+        .fixed("mu", i64::from(report.reading.friction_coef_ppm), 6)
+        .fixed("normal_n", i64::from(report.reading.normal_force_mn), 3)
+        .fixed(
+            "tangential_n",
+            i64::from(report.reading.tangential_force_mn),
+            3,
+        )
+        .fixed("amp", i64::from(report.reading.drive_amplitude_ppm), 6)
+        .fixed("freq_hz", i64::from(report.reading.drive_freq_chz), 2)
         .uint("overruns", u64::from(report.overruns))
         .uint("lost", u64::from(report.lost_telemetry))
         .word("fault", report.latched_fault.unwrap_or(NONE))
@@ -117,6 +108,7 @@ mod tests {
     use crate::protocol::decode::{Reply, parse_reply};
     use crate::protocol::reply::REPLY_CAPACITY;
     use crate::protocol::text::MAX_WORD_LEN;
+    use crate::protocol::{SupervisorState, Target};
     use heapless::String;
     use std::vec::Vec;
 
@@ -124,14 +116,16 @@ mod tests {
 
     fn status_example() -> StatusReport {
         StatusReport {
-            state: SupervisorState::Running,
+            reading: LoopReading {
+                state: SupervisorState::Running,
+                target: Some(Target::Force { force_mn: 12_500 }),
+                friction_coef_ppm: 312_000,
+                normal_force_mn: 40_000,
+                tangential_force_mn: 12_480,
+                drive_amplitude_ppm: 523_000,
+                drive_freq_chz: 4_000_000,
+            },
             scene: Some("demo"),
-            target: Some(Target::Force { force_mn: 12_500 }),
-            friction_coef_ppm: 312_000,
-            normal_force_mn: 40_000,
-            tangential_force_mn: 12_480,
-            drive_amplitude_ppm: 523_000,
-            drive_freq_chz: 4_000_000,
             overruns: 0,
             lost_telemetry: 0,
             latched_fault: None,
@@ -159,16 +153,18 @@ mod tests {
         let word = "w".repeat(MAX_WORD_LEN);
         let word: &'static str = word.leak();
         let report = StatusReport {
-            state: SupervisorState::Calibrating,
+            reading: LoopReading {
+                state: SupervisorState::Calibrating,
+                target: Some(Target::Reduction {
+                    reduction_mpct: u32::MAX,
+                }),
+                friction_coef_ppm: u32::MAX,
+                normal_force_mn: i32::MIN,
+                tangential_force_mn: i32::MIN,
+                drive_amplitude_ppm: u32::MAX,
+                drive_freq_chz: u32::MAX,
+            },
             scene: Some(word),
-            target: Some(Target::Reduction {
-                reduction_mpct: u32::MAX,
-            }),
-            friction_coef_ppm: u32::MAX,
-            normal_force_mn: i32::MIN,
-            tangential_force_mn: i32::MIN,
-            drive_amplitude_ppm: u32::MAX,
-            drive_freq_chz: u32::MAX,
             overruns: u32::MAX,
             lost_telemetry: u32::MAX,
             latched_fault: Some(word),

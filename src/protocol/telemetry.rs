@@ -8,8 +8,9 @@ use heapless::string::StringView;
 
 use super::decode::{DecodeError, check_pairs, strip_terminator, words};
 use super::number::{NumberError, decode_i32, decode_u32, decode_u64};
+use super::reading::LoopReading;
 use super::state::SupervisorState;
-use super::target::{Target, decode_target, write_target};
+use super::target::{decode_target, write_target};
 use super::text::{FormatError, put, put_fixed, put_uint, write_line};
 
 /// First word of every telemetry line; replies start with `ok` or `err`.
@@ -26,20 +27,8 @@ pub struct TelemetryRecord {
     pub time_us: u64,
     /// Record number, +1 per record produced (sent or lost), wrapping.
     pub seq: u32,
-    /// Supervisor state.
-    pub state: SupervisorState,
-    /// Friction target, if set.
-    pub target: Option<Target>,
-    /// Friction coefficient estimate in ppm (1e-6).
-    pub friction_coef_ppm: u32,
-    /// Normal force in mN.
-    pub normal_force_mn: i32,
-    /// Tangential (friction) force in mN.
-    pub tangential_force_mn: i32,
-    /// Drive amplitude in ppm of full scale.
-    pub drive_amplitude_ppm: u32,
-    /// Drive frequency in cHz (0.01 Hz).
-    pub drive_freq_chz: u32,
+    /// State, target, friction estimate and drive.
+    pub reading: LoopReading,
     /// Control-loop overruns since boot.
     pub overruns: u32,
     /// Records dropped since boot because the UART was still busy.
@@ -74,19 +63,31 @@ pub fn format_telemetry(record: &TelemetryRecord, out: &mut StringView) -> Resul
         key(out, KEY_SEQ)?;
         put_uint(out, u64::from(record.seq))?;
         key(out, KEY_STATE)?;
-        put(out, record.state.name())?;
+        put(out, record.reading.state.name())?;
         key(out, KEY_TARGET)?;
-        write_target(out, record.target.as_ref())?;
+        write_target(out, record.reading.target.as_ref())?;
         key(out, KEY_MU)?;
-        put_fixed(out, i64::from(record.friction_coef_ppm), PPM_DECIMALS)?;
+        put_fixed(
+            out,
+            i64::from(record.reading.friction_coef_ppm),
+            PPM_DECIMALS,
+        )?;
         key(out, KEY_NORMAL)?;
-        put_fixed(out, i64::from(record.normal_force_mn), MN_DECIMALS)?;
+        put_fixed(out, i64::from(record.reading.normal_force_mn), MN_DECIMALS)?;
         key(out, KEY_TANGENTIAL)?;
-        put_fixed(out, i64::from(record.tangential_force_mn), MN_DECIMALS)?;
+        put_fixed(
+            out,
+            i64::from(record.reading.tangential_force_mn),
+            MN_DECIMALS,
+        )?;
         key(out, KEY_AMP)?;
-        put_fixed(out, i64::from(record.drive_amplitude_ppm), PPM_DECIMALS)?;
+        put_fixed(
+            out,
+            i64::from(record.reading.drive_amplitude_ppm),
+            PPM_DECIMALS,
+        )?;
         key(out, KEY_FREQ)?;
-        put_fixed(out, i64::from(record.drive_freq_chz), CHZ_DECIMALS)?;
+        put_fixed(out, i64::from(record.reading.drive_freq_chz), CHZ_DECIMALS)?;
         key(out, KEY_OVERRUNS)?;
         put_uint(out, u64::from(record.overruns))?;
         key(out, KEY_LOST)?;
@@ -150,13 +151,16 @@ pub fn parse_telemetry(line: &str) -> Result<TelemetryRecord, DecodeError> {
     let record = TelemetryRecord {
         time_us: fields.number(KEY_TIME, 0, decode_u64)?,
         seq: fields.number(KEY_SEQ, 0, decode_u32)?,
-        state: SupervisorState::from_name(fields.next(KEY_STATE)?).ok_or(DecodeError::BadState)?,
-        target: decode_target(fields.next(KEY_TARGET)?).map_err(DecodeError::BadTarget)?,
-        friction_coef_ppm: fields.number(KEY_MU, PPM_DECIMALS, decode_u32)?,
-        normal_force_mn: fields.number(KEY_NORMAL, MN_DECIMALS, decode_i32)?,
-        tangential_force_mn: fields.number(KEY_TANGENTIAL, MN_DECIMALS, decode_i32)?,
-        drive_amplitude_ppm: fields.number(KEY_AMP, PPM_DECIMALS, decode_u32)?,
-        drive_freq_chz: fields.number(KEY_FREQ, CHZ_DECIMALS, decode_u32)?,
+        reading: LoopReading {
+            state: SupervisorState::from_name(fields.next(KEY_STATE)?)
+                .ok_or(DecodeError::BadState)?,
+            target: decode_target(fields.next(KEY_TARGET)?).map_err(DecodeError::BadTarget)?,
+            friction_coef_ppm: fields.number(KEY_MU, PPM_DECIMALS, decode_u32)?,
+            normal_force_mn: fields.number(KEY_NORMAL, MN_DECIMALS, decode_i32)?,
+            tangential_force_mn: fields.number(KEY_TANGENTIAL, MN_DECIMALS, decode_i32)?,
+            drive_amplitude_ppm: fields.number(KEY_AMP, PPM_DECIMALS, decode_u32)?,
+            drive_freq_chz: fields.number(KEY_FREQ, CHZ_DECIMALS, decode_u32)?,
+        },
         overruns: fields.number(KEY_OVERRUNS, 0, decode_u32)?,
         lost_records: fields.number(KEY_LOST, 0, decode_u32)?,
     };
@@ -169,6 +173,7 @@ pub fn parse_telemetry(line: &str) -> Result<TelemetryRecord, DecodeError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::protocol::Target;
     use crate::protocol::decode::{Incoming, parse_incoming};
     use heapless::String;
     use proptest::prelude::*;
@@ -183,13 +188,15 @@ mod tests {
         TelemetryRecord {
             time_us: 1_250_000,
             seq: 12_500,
-            state: SupervisorState::Running,
-            target: Some(Target::Force { force_mn: 12_500 }),
-            friction_coef_ppm: 312_000,
-            normal_force_mn: 40_000,
-            tangential_force_mn: -12_480,
-            drive_amplitude_ppm: 523_000,
-            drive_freq_chz: 4_000_000,
+            reading: LoopReading {
+                state: SupervisorState::Running,
+                target: Some(Target::Force { force_mn: 12_500 }),
+                friction_coef_ppm: 312_000,
+                normal_force_mn: 40_000,
+                tangential_force_mn: -12_480,
+                drive_amplitude_ppm: 523_000,
+                drive_freq_chz: 4_000_000,
+            },
             overruns: 0,
             lost_records: 3,
         }
@@ -213,15 +220,17 @@ mod tests {
         let record = TelemetryRecord {
             time_us: u64::MAX,
             seq: u32::MAX,
-            state: SupervisorState::Calibrating,
-            target: Some(Target::Reduction {
-                reduction_mpct: u32::MAX,
-            }),
-            friction_coef_ppm: u32::MAX,
-            normal_force_mn: i32::MIN,
-            tangential_force_mn: i32::MIN,
-            drive_amplitude_ppm: u32::MAX,
-            drive_freq_chz: u32::MAX,
+            reading: LoopReading {
+                state: SupervisorState::Calibrating,
+                target: Some(Target::Reduction {
+                    reduction_mpct: u32::MAX,
+                }),
+                friction_coef_ppm: u32::MAX,
+                normal_force_mn: i32::MIN,
+                tangential_force_mn: i32::MIN,
+                drive_amplitude_ppm: u32::MAX,
+                drive_freq_chz: u32::MAX,
+            },
             overruns: u32::MAX,
             lost_records: u32::MAX,
         };
@@ -308,13 +317,15 @@ mod tests {
                     TelemetryRecord {
                         time_us,
                         seq,
-                        state,
-                        target,
-                        friction_coef_ppm: mu,
-                        normal_force_mn: normal,
-                        tangential_force_mn: tangential,
-                        drive_amplitude_ppm: amp,
-                        drive_freq_chz: freq,
+                        reading: LoopReading {
+                            state,
+                            target,
+                            friction_coef_ppm: mu,
+                            normal_force_mn: normal,
+                            tangential_force_mn: tangential,
+                            drive_amplitude_ppm: amp,
+                            drive_freq_chz: freq,
+                        },
                         overruns,
                         lost_records: lost,
                     }

@@ -41,7 +41,7 @@
 use super::error::ResonanceError;
 use super::phasor::Phasor;
 use crate::drive::Frequency;
-use crate::fx::{self, Q1_31, Q2_30};
+use crate::fx::{self, Q1_31, Q2_30, mul_hi_round};
 
 /// Longest demodulation window, samples (2^20: one second at 1 MSPS), which bounds the sums.
 pub const MAX_WINDOW_SAMPLES: u32 = 1 << 20;
@@ -184,8 +184,8 @@ impl LockIn {
     pub fn push(&mut self, sample: Q1_31) -> Option<Demodulated> {
         let (sin, cos) = fx::sin_cos(self.drive_phase.wrapping_sub(self.delay));
         let (x, sin, cos) = (sample.to_bits(), sin.to_bits(), cos.to_bits());
-        self.sum_x_cos += mul_hi_round(x, cos);
-        self.sum_x_sin += mul_hi_round(x, sin);
+        self.sum_x_cos += i64::from(mul_hi_round(x, cos));
+        self.sum_x_sin += i64::from(mul_hi_round(x, sin));
         self.sum_x += i64::from(x);
         self.sum_cos += i64::from(cos);
         self.sum_sin += i64::from(sin);
@@ -249,12 +249,6 @@ impl LockIn {
         self.sum_cos = 0;
         self.sum_sin = 0;
     }
-}
-
-/// `round(a b / 2^32)` (ties up) as `i64`: one `SMMULR` on the Cortex-M4.
-#[inline(always)]
-const fn mul_hi_round(a: i32, b: i32) -> i64 {
-    (a as i64 * b as i64 + (1 << 31)) >> 32
 }
 
 /// A Q2.30 component, clamped (only a pathological window reaches +-2).

@@ -8,7 +8,7 @@
 //! [`crate::sense::BridgeAmplifier`]). Integer only: one 64-bit product per sample.
 
 use super::error::SenseError;
-use crate::fx::{Q1_31, Q16_16, Sat};
+use crate::fx::{Q1_31, Q16_16, Sat, div_round_i64};
 
 /// Offset and span of one channel. `Copy`, so a loop can swap in a new calibration at once.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -67,7 +67,7 @@ impl Calibration {
         }
         // span = load / delta * 2^31: |load << 31| <= 2^62, delta != 0.
         let numerator = (load.to_bits() as i64) << 31;
-        let span = div_round(numerator, delta);
+        let span = div_round_i64(numerator, delta);
         if span > i32::MAX as i64 || span < i32::MIN as i64 {
             return Err(SenseError::Overflow);
         }
@@ -102,7 +102,7 @@ impl Calibration {
         if span == 0 {
             return Err(SenseError::Overflow);
         }
-        let delta = div_round((value.to_bits() as i64) << 31, span);
+        let delta = div_round_i64((value.to_bits() as i64) << 31, span);
         let reading = self.offset.to_bits() as i64 + delta;
         if reading > i32::MAX as i64 || reading < i32::MIN as i64 {
             return Err(SenseError::Overflow);
@@ -124,26 +124,9 @@ pub fn mean(readings: impl IntoIterator<Item = Q1_31>) -> Option<Q1_31> {
         return None;
     }
     // The mean of i32 values is an i32.
-    i32::try_from(div_round(sum, count))
+    i32::try_from(div_round_i64(sum, count))
         .ok()
         .map(Q1_31::from_bits)
-}
-
-/// `numerator / denominator` rounded to nearest (ties away from zero); `denominator != 0`.
-/// Callers keep `|numerator| < 2^63 - |denominator|`.
-const fn div_round(numerator: i64, denominator: i64) -> i64 {
-    let half = denominator.unsigned_abs() as i64 / 2;
-    let biased = if (numerator < 0) == (denominator < 0) {
-        numerator.saturating_add(if numerator < 0 { -half } else { half })
-    } else {
-        numerator.saturating_sub(if numerator < 0 { half } else { -half })
-    };
-    // `denominator` is not zero at any call site; -1 with i64::MIN cannot occur (|numerator|
-    // <= 2^62 there).
-    match biased.checked_div(denominator) {
-        Some(quotient) => quotient,
-        None => 0,
-    }
 }
 
 #[cfg(test)]
@@ -233,16 +216,5 @@ mod tests {
         assert_eq!(mean([Q1_31::MIN; 1000]), Some(Q1_31::MIN));
         let negative = [Q1_31::from_bits(-1), Q1_31::from_bits(-2)];
         assert_eq!(mean(negative), Some(Q1_31::from_bits(-2)));
-    }
-
-    #[test]
-    fn rounding_division_rounds_half_away_from_zero_in_every_quadrant() {
-        assert_eq!(div_round(7, 2), 4);
-        assert_eq!(div_round(-7, 2), -4);
-        assert_eq!(div_round(7, -2), -4);
-        assert_eq!(div_round(-7, -2), 4);
-        assert_eq!(div_round(5, 3), 2);
-        assert_eq!(div_round(4, 3), 1);
-        assert_eq!(div_round(1, 0), 0);
     }
 }

@@ -54,7 +54,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Timer};
 use sonolube_app::console::Identity;
-use sonolube_app::control::{ControlLoop, Injection};
+use sonolube_app::control::ControlLoop;
 use sonolube_app::{Board, control, heartbeat, link, supervisor};
 use sonolube_g474_hw::{clock, iwdg};
 use static_cell::StaticCell;
@@ -249,7 +249,7 @@ async fn control_task(settings: Settings) {
         BoardRig::CYCLE_HZ
     );
     rig.inner().log_model();
-    let stats = control::run(&mut rig, |_| Injection::None).await;
+    let stats = control::run(&mut rig).await;
     // The board's loop has no end of job; should it end, the drive goes safe.
     safe::drive_safe();
     defmt::error!("control loop ended: {}", stats);

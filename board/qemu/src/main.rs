@@ -26,6 +26,7 @@ mod bench;
 mod drive;
 mod executor;
 mod exit;
+mod failure;
 mod flash;
 mod irq;
 mod report;
@@ -39,9 +40,8 @@ use embassy_executor::{SendSpawner, raw};
 use embassy_time::{Duration, Instant};
 use sonolube::settings::{Source, boot};
 use sonolube_app::console::Identity;
-use sonolube_app::control::Injection;
 use sonolube_app::persist::Persisted;
-use sonolube_app::{Board, console, control, heartbeat, supervisor};
+use sonolube_app::{Board, console, heartbeat, supervisor};
 use sonolube_sim::Mode;
 use static_cell::StaticCell;
 
@@ -111,24 +111,6 @@ fn inject_boot_failure(wakeups: u32) {
         #[allow(clippy::empty_loop)]
         loop {}
     }
-}
-
-/// In test builds, fails the control task half-way through the scene.
-fn inject_control_failure(step: u32, steps: u32) -> Injection {
-    if step != steps / 2 {
-        return Injection::None;
-    }
-    if cfg!(feature = "panic-test") {
-        defmt::warn!(
-            "test build: panicking in the control task, drive {}",
-            drive::state()
-        );
-        panic!("deliberate panic at control step {}", step);
-    }
-    if cfg!(feature = "watchdog-test") {
-        return Injection::Hang;
-    }
-    Injection::None
 }
 
 #[embassy_executor::task]
@@ -215,7 +197,7 @@ async fn control_task(mut rig: Rig, args: Args) {
         executor::idle_cycles(),
         time_driver::excluded_cycles(),
     );
-    let stats = control::run(&mut rig, |step| inject_control_failure(step, steps)).await;
+    let stats = failure::run(&mut rig, steps).await;
     let elapsed = time_driver::cycles().saturating_sub(start.0);
     let plant = time_driver::excluded_cycles().saturating_sub(start.2);
     let idle = executor::idle_cycles().saturating_sub(start.1);

@@ -1,0 +1,240 @@
+//! `sonolube eval`: evaluates a model in fixed point and in the f64 reference, as JSON.
+//!
+//! ```text
+//! sonolube eval MODEL key=value ...     one JSON object on stdout
+//! sonolube eval --batch                 JSON lines in, JSON lines out
+//! sonolube eval --list                  the model names
+//! ```
+//!
+//! A `key=value` whose key is a variant key (`E_star_rule`, `contact`, `window`, `u_phase`,
+//! `quadrature_points`) is a variant choice; every other key is an input in SI units. A batch
+//! line is `{"model": ..., "inputs": {...}, "variant": {...}}` (variant optional; its values
+//! are strings or whole numbers). Each answer is `{"outputs": {...}, "reference": {...}}`:
+//! the fixed-point result converted to SI and the f64 reference, with the same keys; or
+//! `{"error": "..."}` for an unknown model, a missing or unknown key, an out-of-domain value,
+//! or a malformed line. A batch never stops on a bad line. Exit status: 0, or 1 when the single
+//! evaluation failed, 2 on usage errors.
+//!
+//! At the extremes (`fixed_eval::extremes`): an output that is undefined at the inputs (zeta
+//! without vibration, a ratio to or a percent reduction of zero friction) is `null` on the side
+//! where it is undefined, and `"undefined": {key: reason}` says why; it is never a finite
+//! stand-in nor a limit value. `"flags": {key: reason}` names an input `f` outside the 20-60 kHz
+//! drive band and an output outside its physical range (for example a friction ratio below
+//! zero); the numbers are kept, the flag says why they are not physical. Both fields are
+//! present only when not empty.
+
+use std::collections::BTreeMap;
+use std::io::{BufRead, Write};
+use std::process::ExitCode;
+
+use serde_json::{Map, Value, json};
+
+use sonolube_host::fixed_eval::extremes::{flags, undefined_keys, undefined_reason};
+use sonolube_host::fixed_eval::{Outputs, eval_fixed_named, models};
+use sonolube_host::reference::eval_named;
+
+/// Keys that select a variant rather than give an input.
+pub const VARIANT_KEYS: &[&str] = &[
+    "E_star_rule",
+    "contact",
+    "window",
+    "u_phase",
+    "quadrature_points",
+];
+
+const USAGE: &str =
+    "usage: sonolube eval MODEL key=value ... | sonolube eval --batch | sonolube eval --list\n";
+
+/// Entry point of `sonolube eval`.
+pub fn run(args: &[String]) -> ExitCode {
+    match args.first().map(String::as_str) {
+        None | Some("--help") | Some("-h") => {
+            eprint!("{USAGE}");
+            ExitCode::from(2)
+        }
+        Some("--list") => {
+            for model in models() {
+                println!("{model}");
+            }
+            ExitCode::SUCCESS
+        }
+        Some("--batch") if args.len() == 1 => batch(),
+        Some("--batch") => {
+            eprint!("{USAGE}");
+            ExitCode::from(2)
+        }
+        Some(model) => {
+            let answer = single(model, &args[1..]);
+            let failed = answer.get("error").is_some();
+            println!("{answer}");
+            if failed {
+                ExitCode::from(1)
+            } else {
+                ExitCode::SUCCESS
+            }
+        }
+    }
+}
+
+/// One evaluation from command-line `key=value` words.
+fn single(model: &str, words: &[String]) -> Value {
+    let mut inputs = BTreeMap::new();
+    let mut variant = BTreeMap::new();
+    for word in words {
+        let Some((key, value)) = word.split_once('=') else {
+            return error(format!("`{word}` is not key=value"));
+        };
+        if VARIANT_KEYS.contains(&key) {
+            variant.insert(key.to_string(), value.to_string());
+        } else {
+            match value.trim().parse::<f64>() {
+                Ok(number) => {
+                    inputs.insert(key.to_string(), number);
+                }
+                Err(_) => return error(format!("input `{key}`: `{value}` is not a number")),
+            }
+        }
+    }
+    evaluate(model, &inputs, &variant)
+}
+
+/// Reads JSON lines from stdin and answers each on stdout.
+fn batch() -> ExitCode {
+    let stdin = std::io::stdin();
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    for line in stdin.lock().lines() {
+        let answer = match line {
+            Ok(line) if line.trim().is_empty() => continue,
+            Ok(line) => batch_line(&line),
+            Err(e) => error(format!("unreadable input line: {e}")),
+        };
+        if writeln!(out, "{answer}").is_err() {
+            return ExitCode::from(1);
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+/// Answers one batch line.
+pub fn batch_line(line: &str) -> Value {
+    let request: Value = match serde_json::from_str(line) {
+        Ok(value) => value,
+        Err(e) => return error(format!("not a JSON object: {e}")),
+    };
+    let Some(object) = request.as_object() else {
+        return error("a line must be a JSON object".into());
+    };
+    if let Some(key) = object
+        .keys()
+        .find(|k| !matches!(k.as_str(), "model" | "inputs" | "variant"))
+    {
+        return error(format!("unknown field `{key}` (model, inputs, variant)"));
+    }
+    let Some(model) = object.get("model").and_then(Value::as_str) else {
+        return error("`model` (a string) is missing".into());
+    };
+    let inputs = match object.get("inputs") {
+        None => BTreeMap::new(),
+        Some(Value::Object(map)) => match numbers(map) {
+            Ok(inputs) => inputs,
+            Err(message) => return error(message),
+        },
+        Some(_) => return error("`inputs` must be an object".into()),
+    };
+    let variant = match object.get("variant") {
+        None | Some(Value::Null) => BTreeMap::new(),
+        Some(Value::Object(map)) => match choices(map) {
+            Ok(variant) => variant,
+            Err(message) => return error(message),
+        },
+        Some(_) => return error("`variant` must be an object".into()),
+    };
+    evaluate(model, &inputs, &variant)
+}
+
+fn numbers(map: &Map<String, Value>) -> Result<BTreeMap<String, f64>, String> {
+    map.iter()
+        .map(|(key, value)| match value.as_f64() {
+            Some(number) => Ok((key.clone(), number)),
+            None => Err(format!("input `{key}` must be a number")),
+        })
+        .collect()
+}
+
+fn choices(map: &Map<String, Value>) -> Result<BTreeMap<String, String>, String> {
+    map.iter()
+        .map(|(key, value)| match value {
+            Value::String(text) => Ok((key.clone(), text.clone())),
+            Value::Number(number) if number.is_u64() => Ok((key.clone(), number.to_string())),
+            _ => Err(format!(
+                "variant `{key}` must be a string or a whole number"
+            )),
+        })
+        .collect()
+}
+
+/// Fixed point and reference for one request, or an error naming the side that failed.
+pub fn evaluate(
+    model: &str,
+    inputs: &BTreeMap<String, f64>,
+    variant: &BTreeMap<String, String>,
+) -> Value {
+    let reference = match eval_named(model, inputs, variant) {
+        Ok(outputs) => outputs,
+        Err(e) => return error(e.to_string()),
+    };
+    match eval_fixed_named(model, inputs, variant) {
+        Ok(outputs) => answer(model, inputs, &outputs, &reference),
+        Err(e) => error(format!("fixed point: {e}")),
+    }
+}
+
+/// The JSON answer: both sides with `null` for their undefined outputs, the reasons, the flags.
+fn answer(
+    model: &str,
+    inputs: &BTreeMap<String, f64>,
+    fixed: &Outputs,
+    reference: &Outputs,
+) -> Value {
+    let mut undefined = Map::new();
+    let mut missing: Vec<&str> = undefined_keys(model, fixed);
+    missing.extend(undefined_keys(model, reference));
+    // A key one side gives and the other does not is undefined on the other side.
+    missing.extend(fixed.keys().filter(|k| !reference.contains_key(*k)));
+    missing.extend(reference.keys().filter(|k| !fixed.contains_key(*k)));
+    for key in missing {
+        let why = undefined_reason(model, key).unwrap_or("not computed on this side");
+        undefined.insert(key.to_string(), json!(why));
+    }
+    let mut result = Map::new();
+    result.insert("outputs".into(), as_json(fixed, &undefined));
+    result.insert("reference".into(), as_json(reference, &undefined));
+    if !undefined.is_empty() {
+        result.insert("undefined".into(), Value::Object(undefined));
+    }
+    let flags: Map<String, Value> = flags(model, inputs, fixed, reference)
+        .into_iter()
+        .map(|(key, why)| (key.to_string(), json!(why)))
+        .collect();
+    if !flags.is_empty() {
+        result.insert("flags".into(), Value::Object(flags));
+    }
+    Value::Object(result)
+}
+
+/// The side's outputs, with `null` for each key in `undefined` it does not give.
+fn as_json(outputs: &Outputs, undefined: &Map<String, Value>) -> Value {
+    let mut map: Map<String, Value> = outputs
+        .iter()
+        .map(|(key, value)| (key.to_string(), json!(value)))
+        .collect();
+    for key in undefined.keys() {
+        map.entry(key.clone()).or_insert(Value::Null);
+    }
+    Value::Object(map)
+}
+
+fn error(message: String) -> Value {
+    json!({ "error": message })
+}
