@@ -26,6 +26,8 @@ pub(crate) mod dahl_cycle;
 pub(crate) mod dahl_quadrature;
 pub mod dahl_relax;
 pub mod dahl_steady;
+#[cfg(test)]
+mod dahl_tests;
 pub(crate) mod dahl_travel;
 pub mod dahl_window;
 pub mod exp_coulomb;

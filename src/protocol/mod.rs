@@ -143,6 +143,8 @@ mod telemetry;
 mod text;
 
 #[cfg(test)]
+mod parse_tests;
+#[cfg(test)]
 mod props;
 
 pub use code::ErrorCode;
