@@ -80,8 +80,17 @@ fn log_uniform(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
     (lo.ln()..hi.ln()).prop_map(f64::exp)
 }
 
+/// Failing cases are kept in, and replayed from, `tests/<this file>.proptest-regressions`:
+/// named here because proptest's default (a `proptest-regressions` folder beside the
+/// nearest `lib.rs`) finds no `lib.rs` above `tests/` and only falls back to it with a warning.
+fn regressions() -> Option<Box<dyn proptest::test_runner::FailurePersistence>> {
+    Some(Box::new(
+        proptest::test_runner::FileFailurePersistence::WithSource("proptest-regressions"),
+    ))
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 2000, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 2000, failure_persistence: regressions(), ..ProptestConfig::default() })]
     /// Any load, stiffness, velocity, time (0 to 200 time constants) and start within the
     /// Q2.30 range of f0 (|f0| < 2): the fixed point is within its format bound of the
     /// reference at the real inputs.

@@ -583,8 +583,17 @@ fn actuator_map(v: f64, f: f64, bolt: f64, c: f64) -> Inputs {
     inputs
 }
 
+/// Failing cases are kept in, and replayed from, `tests/<this file>.proptest-regressions`:
+/// named here because proptest's default (a `proptest-regressions` folder beside the
+/// nearest `lib.rs`) finds no `lib.rs` above `tests/` and only falls back to it with a warning.
+fn regressions() -> Option<Box<dyn proptest::test_runner::FailurePersistence>> {
+    Some(Box::new(
+        proptest::test_runner::FileFailurePersistence::WithSource("proptest-regressions"),
+    ))
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 3000, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 3000, failure_persistence: regressions(), ..ProptestConfig::default() })]
 
     #[test]
     fn littmann_over_the_domain(
@@ -633,7 +642,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 1500, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 1500, failure_persistence: regressions(), ..ProptestConfig::default() })]
 
     #[test]
     fn sampled_sign_over_the_domain(
@@ -677,7 +686,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 400, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 400, failure_persistence: regressions(), ..ProptestConfig::default() })]
 
     /// alpha != 1 needs N = 128 for 1e-3 (alpha < 1 converges slowest).
     #[test]

@@ -197,3 +197,20 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn reset_returns_to_rest() {
+    let (mut pi, g) = wound_up(1.0);
+    let c = pi.candidate(&g, q(0.3));
+    pi.commit(&g, c, Clamp::Upper);
+    assert!(pi.frozen() && pi.integral() != Q2_30::ZERO);
+    pi.reset();
+    assert_eq!(pi, Pi::new());
+    assert_eq!(
+        (pi.integral(), pi.correction(), pi.frozen()),
+        (Q2_30::ZERO, Q2_30::ZERO, false)
+    );
+    // And the next step starts from nothing: c = kp e + ki T e.
+    let c = pi.candidate(&g, q(0.1));
+    assert!((pi.commit(&g, c, Clamp::Free).to_f64() - 0.2).abs() < 2e-9);
+}
