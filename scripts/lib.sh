@@ -86,3 +86,15 @@ ensure_defmt_print() {
 ensure_qemu_tools() {
   ensure_toolchain && ensure_qemu && ensure_defmt_print
 }
+
+# cargo-mutants, the mutation tester of scripts/mutants (pinned: its output format and the
+# mutants it generates change between versions, and docs/testing.md quotes its counts).
+CARGO_MUTANTS_VERSION=27.1.0
+ensure_cargo_mutants() {
+  if command -v cargo-mutants >/dev/null 2>&1 &&
+    cargo mutants --version 2>/dev/null | grep -qF "$CARGO_MUTANTS_VERSION"; then
+    return 0
+  fi
+  say "installing cargo-mutants $CARGO_MUTANTS_VERSION (cargo install --locked, about 3 min)"
+  cargo install cargo-mutants --locked --version "=$CARGO_MUTANTS_VERSION" --quiet
+}

@@ -210,6 +210,7 @@ fn every_shipped_scene_runs_to_its_end() {
                 .map(|v| v.measured)
                 .collect::<Vec<_>>()
         );
+        assert!(summary.passed(), "{}: {summary:?}", scene.name);
     }
 }
 

@@ -414,8 +414,17 @@ fn material() -> impl Strategy<Value = Pairs<'static>> {
     prop_oneof![Just(AL_SS), Just(SS_SS)]
 }
 
+/// Failing cases are kept in, and replayed from, `tests/<this file>.proptest-regressions`:
+/// named here because proptest's default (a `proptest-regressions` folder beside the
+/// nearest `lib.rs`) finds no `lib.rs` above `tests/` and only falls back to it with a warning.
+fn regressions() -> Option<Box<dyn proptest::test_runner::FailurePersistence>> {
+    Some(Box::new(
+        proptest::test_runner::FileFailurePersistence::WithSource("proptest-regressions"),
+    ))
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 1000, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 1000, failure_persistence: regressions(), ..ProptestConfig::default() })]
 
     #[test]
     fn contact_matches_over_the_load_range(

@@ -6,7 +6,8 @@
 //! loads 1 mN to 50 kN).
 //!
 //! The yardstick is the reference evaluated at the inputs as the fixed-point path represented
-//! them (`eval_with_quantized_inputs`; 2^-24 relative or better), so that representation and
+//! them (`eval_with_quantized_inputs`, checked against the real inputs within each format's
+//! quantisation bound: `quantisation_bound`), so that representation and
 //! algorithm are told apart; the paper cases are also checked at the SI inputs. Tolerances:
 //! closed forms 1e-4 relative (plus half an ulp of the output's fixed format where an output is
 //! carried in one: forces in the load's format, the actuator's Q8.24 / Q16.16 outputs),
@@ -78,6 +79,72 @@ fn tolerance(model: &str, key: &str, want: f64, inputs: &Inputs) -> f64 {
     }
 }
 
+/// Half an ulp of `2^-frac`.
+fn half_ulp(frac: i32) -> f64 {
+    0.5 * 2f64.powi(-frac)
+}
+
+/// The most an input `key` = `x` may move when the fixed-point path represents it, by the
+/// format `fixed_eval::coulomb_dahl` states for it (rounded to nearest: half an ulp):
+/// coefficients Q8.24, f0 and zeta Q2.30 (zeta Q16.16 from 2, only its sign beyond 32768),
+/// velocities Q8.24 below 127 m/s else Q16.16, loads in the finest of Q1.31 / Q8.24 / Q16.16 /
+/// Q24.8 that holds the largest force of the model (mu W, with 0.1 % margin), amplitudes a
+/// Q1.31 fraction in [1/2, 1) of a power-of-two full scale (2^-31 relative), actuator volts
+/// Q16.16, kilohertz Q16.16, amperes Q8.24. Every other input is used as given.
+fn quantisation_bound(key: &str, x: f64, inputs: &Inputs) -> f64 {
+    let headroom = ["mu", "mu_s", "mu_d"]
+        .iter()
+        .filter_map(|k| inputs.get(*k))
+        .fold(1.0f64, |m, mu| m.max(*mu));
+    match key {
+        "mu" | "mu_s" | "mu_d" => half_ulp(24),
+        "f0" => half_ulp(30),
+        "zeta" if x.abs() >= 32768.0 => f64::INFINITY,
+        "zeta" if x.abs() >= 2.0 => half_ulp(16),
+        "zeta" => half_ulp(30),
+        "v" | "Vs" if x.abs() < 127.0 => half_ulp(24),
+        "v" | "Vs" => half_ulp(16),
+        "W" | "F_N" => {
+            let top = x.abs() * headroom * 1.001;
+            half_ulp(if top < 1.0 {
+                31
+            } else if top < 127.0 {
+                24
+            } else if top < 32767.0 {
+                16
+            } else {
+                8
+            })
+        }
+        "x_a" | "v_a" => 2f64.powi(-31) * x.abs(),
+        "V" | "V_max" => half_ulp(16),
+        "f" if inputs.contains_key("V") => half_ulp(16) * 1e3,
+        "I_max" => half_ulp(24),
+        _ => 0.0,
+    }
+}
+
+/// The inputs the fixed-point path used are the real inputs to within their formats'
+/// quantisation (so that running the reference at them still tests the real case).
+fn check_quantized(model: &str, inputs: &Inputs, quantized: &Inputs) -> Result<(), String> {
+    if inputs.keys().ne(quantized.keys()) {
+        return Err(format!(
+            "{model}: quantized keys {quantized:?} vs {inputs:?}"
+        ));
+    }
+    for (key, &x) in inputs {
+        let q = quantized[key];
+        let bound = quantisation_bound(key, x, inputs);
+        if (q - x).abs() > bound * (1.0 + 1e-12) {
+            return Err(format!(
+                "{model}: input {key} = {x:e} was used as {q:e}, {:e} away (bound {bound:e})",
+                (q - x).abs()
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Worst error of `model` at `inputs` as a fraction of the tolerance (<= 1 passes), or why
 /// the two sides disagree. Both sides refusing is agreement.
 fn compare(model: &str, inputs: &Inputs, variant: &Variant) -> Result<f64, String> {
@@ -92,6 +159,7 @@ fn compare(model: &str, inputs: &Inputs, variant: &Variant) -> Result<f64, Strin
             };
         }
     };
+    check_quantized(model, inputs, &quantized)?;
     let theirs = reference(model, &quantized, variant)
         .map_err(|e| format!("{model}: reference refused ({e}), fixed gave {ours:?}"))?;
     if ours.keys().ne(theirs.keys()) {
@@ -518,8 +586,17 @@ fn actuator_map(v: f64, f: f64, bolt: f64, c: f64) -> Inputs {
     inputs
 }
 
+/// Failing cases are kept in, and replayed from, `tests/<this file>.proptest-regressions`:
+/// named here because proptest's default (a `proptest-regressions` folder beside the
+/// nearest `lib.rs`) finds no `lib.rs` above `tests/` and only falls back to it with a warning.
+fn regressions() -> Option<Box<dyn proptest::test_runner::FailurePersistence>> {
+    Some(Box::new(
+        proptest::test_runner::FileFailurePersistence::WithSource("proptest-regressions"),
+    ))
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 3000, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 3000, failure_persistence: regressions(), ..ProptestConfig::default() })]
 
     #[test]
     fn littmann_over_the_domain(
@@ -568,7 +645,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 1500, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 1500, failure_persistence: regressions(), ..ProptestConfig::default() })]
 
     #[test]
     fn sampled_sign_over_the_domain(
@@ -612,7 +689,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 400, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 400, failure_persistence: regressions(), ..ProptestConfig::default() })]
 
     /// alpha != 1 needs N = 128 for 1e-3 (alpha < 1 converges slowest).
     #[test]

@@ -367,8 +367,17 @@ fn frequency() -> impl Strategy<Value = f64> {
     prop_oneof![Just(20e3), Just(60e3)]
 }
 
+/// Failing cases are kept in, and replayed from, `tests/<this file>.proptest-regressions`:
+/// named here because proptest's default (a `proptest-regressions` folder beside the
+/// nearest `lib.rs`) finds no `lib.rs` above `tests/` and only falls back to it with a warning.
+fn regressions() -> Option<Box<dyn proptest::test_runner::FailurePersistence>> {
+    Some(Box::new(
+        proptest::test_runner::FileFailurePersistence::WithSource("proptest-regressions"),
+    ))
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(192))]
+    #![proptest_config(ProptestConfig { cases: 192, failure_persistence: regressions(), ..ProptestConfig::default() })]
 
     #[test]
     fn littmann_is_odd_bounded_monotone(a in -10.0..10.0f64, b in -10.0..10.0f64) {

@@ -127,6 +127,8 @@ mod closed_loop;
 #[cfg(test)]
 mod controller_tests;
 #[cfg(test)]
+mod pi_tests;
+#[cfg(test)]
 mod property_tests;
 #[cfg(test)]
 mod testkit;

@@ -50,6 +50,8 @@ mod frequency;
 mod limits;
 mod overcurrent;
 mod period;
+#[cfg(test)]
+mod period_tests;
 mod ramp;
 mod timing;
 

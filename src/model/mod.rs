@@ -81,6 +81,9 @@ pub(crate) mod dahl_quadrature;
 pub mod dahl_relax;
 #[path = "dahl/dahl_steady.rs"]
 pub mod dahl_steady;
+#[cfg(test)]
+#[path = "dahl/dahl_tests.rs"]
+mod dahl_tests;
 #[path = "dahl/dahl_travel.rs"]
 pub(crate) mod dahl_travel;
 #[path = "dahl/dahl_window.rs"]

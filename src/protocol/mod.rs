@@ -157,6 +157,8 @@ mod telemetry;
 mod text;
 
 #[cfg(test)]
+mod parse_tests;
+#[cfg(test)]
 mod props;
 
 pub use code::ErrorCode;

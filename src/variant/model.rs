@@ -218,7 +218,8 @@ mod tests {
                     Form::Fixed => 2e-3,
                     Form::F32Micromath => 5e-2,
                     Form::F32Libm => 1e-4,
-                    Form::F64 => 0.0,
+                    // The f64 form is the yardstick here: its twin is itself (issue 18).
+                    Form::F64 => continue,
                 };
                 for at in grid.points() {
                     let got = model.ratio(&at).expect(variant.name);
@@ -249,7 +250,9 @@ mod tests {
             let bound = match variant.form {
                 Form::F32Micromath => 2e-2,
                 Form::F32Libm => 2e-4,
-                _ => 1e-8,
+                // The f64 form is the yardstick here: its twin is itself (issue 18).
+                Form::F64 => continue,
+                Form::Fixed => 1e-8,
             };
             if variant.fidelity == Fidelity::Littmann {
                 assert!(
