@@ -46,11 +46,14 @@ pub enum ErrorCode {
     NoTarget = 23,
     /// 24 `cal-failed`: the calibration could not be completed.
     CalFailed = 24,
+    /// 25 `unavailable`: the command exists but this loop cannot do it (for example `freq
+    /// auto` on a scene whose stack the resonance loop cannot model); the message says why.
+    Unavailable = 25,
 }
 
 impl ErrorCode {
     /// Every code, in numeric order.
-    pub const ALL: [ErrorCode; 18] = [
+    pub const ALL: [ErrorCode; 19] = [
         ErrorCode::UnknownCommand,
         ErrorCode::BadNumber,
         ErrorCode::TrailingGarbage,
@@ -69,9 +72,10 @@ impl ErrorCode {
         ErrorCode::FaultLatched,
         ErrorCode::NoTarget,
         ErrorCode::CalFailed,
+        ErrorCode::Unavailable,
     ];
 
-    /// The number on the wire, `1..=24`.
+    /// The number on the wire, `1..=25`.
     pub const fn code(self) -> u16 {
         self as u16
     }
@@ -97,6 +101,7 @@ impl ErrorCode {
             ErrorCode::FaultLatched => "fault-latched",
             ErrorCode::NoTarget => "no-target",
             ErrorCode::CalFailed => "cal-failed",
+            ErrorCode::Unavailable => "unavailable",
         }
     }
 

@@ -170,6 +170,14 @@ pub enum ProtocolError {
         /// [`MAX_REASON_LEN`] bytes are shown.
         reason: &'static str,
     },
+    /// The command cannot be carried out by this loop in any state (returned by the
+    /// firmware): `unavailable freq: <reason>`.
+    Unavailable {
+        /// The command's keyword.
+        command: &'static str,
+        /// Why, in plain words; at most [`MAX_REASON_LEN`] bytes are shown.
+        reason: &'static str,
+    },
 }
 
 impl ProtocolError {
@@ -194,6 +202,7 @@ impl ProtocolError {
             ProtocolError::FaultLatched { .. } => ErrorCode::FaultLatched,
             ProtocolError::NoTarget => ErrorCode::NoTarget,
             ProtocolError::CalFailed { .. } => ErrorCode::CalFailed,
+            ProtocolError::Unavailable { .. } => ErrorCode::Unavailable,
         }
     }
 
@@ -303,6 +312,11 @@ impl ProtocolError {
             ProtocolError::NoTarget => put(out, "no target set; send target first"),
             ProtocolError::CalFailed { reason } => {
                 put(out, "calibration failed: ")?;
+                put_sanitized(out, reason, MAX_REASON_LEN)
+            }
+            ProtocolError::Unavailable { command, reason } => {
+                put_sanitized(out, command, MAX_WORD_LEN)?;
+                put(out, " is unavailable: ")?;
                 put_sanitized(out, reason, MAX_REASON_LEN)
             }
         }

@@ -64,6 +64,7 @@
 //! (0.0018 %), the timer's 0.59 Hz grid included.
 
 mod error;
+mod follow;
 mod lockin;
 mod motional;
 mod phasor;
@@ -76,6 +77,10 @@ mod tracker;
 mod tuning;
 
 pub use error::{ResonanceError, ResonanceFault};
+pub use follow::{
+    LOST_WINDOWS, LockState, ResonanceLoop, ResonanceReport, ResonanceSettings,
+    SYNCHRONOUS_FIRST_PHASE, SYNCHRONOUS_PHASE_STEP, current_sample,
+};
 pub use lockin::{Demodulated, LockIn, LockInConfig, MAX_WINDOW_SAMPLES};
 pub use motional::{ClampedCapacitance, MAX_DETUNING, detuning};
 pub use phasor::{Angle, Phasor, Polar};
