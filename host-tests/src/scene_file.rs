@@ -270,6 +270,14 @@ fn transducer(t: &toml_scene::Transducer) -> Transducer {
         drive_hz: t.drive_hz,
         clamped_capacitance_f: t.clamped_capacitance_f,
         motional_resistance_ohm: t.motional_resistance_ohm,
+        shift: sonolube::scene::ResonanceShift {
+            thermal_per_k: t.shift.thermal_per_k,
+            thermal_resistance_k_per_w: t.shift.thermal_resistance_k_per_w,
+            thermal_time_constant_s: t.shift.thermal_time_constant_s,
+            load_per_n: t.shift.load_per_n,
+            bvd_envelope: t.shift.bvd_envelope,
+            freq_auto: t.shift.freq_auto,
+        },
     }
 }
 
