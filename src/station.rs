@@ -109,6 +109,9 @@ pub struct Station {
     auto_armed: bool,
     /// A `start` waits for the search to lock.
     start_pending: bool,
+    /// The board feeds current samples ([`Self::enable_current_sense`]): `freq auto` is
+    /// possible.
+    current_sense: bool,
     /// The drive amplitude the station returned last (what the drive applies over the
     /// period whose current samples come next).
     applied: Amplitude,
@@ -193,8 +196,15 @@ impl Station {
             resonance,
             auto_armed: false,
             start_pending: false,
+            current_sense: false,
             applied: Amplitude::ZERO,
         })
+    }
+
+    /// Declares that the board calls [`Self::push_current`] every period. Until then `freq
+    /// auto` is refused (`unavailable`): a search without samples would never end.
+    pub fn enable_current_sense(&mut self) {
+        self.current_sense = true;
     }
 
     /// The current samples (12-bit current-sense codes, mid-scale zero) taken synchronously
@@ -328,6 +338,12 @@ impl Station {
             }
             Command::Stop => self.controller.stop().map_err(refused),
             Command::FreqAuto => {
+                if !self.current_sense {
+                    return Err(ProtocolError::Unavailable {
+                        command: command.keyword(),
+                        reason: "this board does not sample the drive current",
+                    });
+                }
                 let resonance = self.resonance.as_mut().ok_or(ProtocolError::Unavailable {
                     command: command.keyword(),
                     reason: self.resonance_refused,

@@ -31,6 +31,10 @@ pub struct Snapshot {
     /// Board cycles the step's control part took (sense, estimate, model, control, drive
     /// command), in the board's cycle clock ([`crate::control::ControlLoop::CYCLE_HZ`]).
     pub control_cycles: u32,
+    /// The resonance loop's state word, if the station has a loop.
+    pub lock: Option<&'static str>,
+    /// The motional current's phase to the voltage, millidegrees; `None` when undefined.
+    pub phase_mdeg: Option<i32>,
 }
 
 impl Snapshot {
@@ -47,6 +51,8 @@ impl Snapshot {
         latched_fault: None,
         active_fault: None,
         control_cycles: 0,
+        lock: None,
+        phase_mdeg: None,
     };
 
     /// The snapshot of a controller `output`, with the loop's other facts.
@@ -70,6 +76,20 @@ impl Snapshot {
             latched_fault: output.fault.map(|reason| reason.name()),
             active_fault,
             control_cycles,
+            lock: None,
+            phase_mdeg: None,
+        }
+    }
+
+    /// This snapshot with the station's resonance report (`None`: no loop).
+    pub fn with_resonance(self, report: Option<sonolube::resonance::ResonanceReport>) -> Self {
+        Snapshot {
+            lock: report.map(|r| r.state.name()),
+            phase_mdeg: report.and_then(|r| r.phase).map(|phase| {
+                // 360 000 mdeg per 2^32: |result| <= 180 000.
+                ((i64::from(phase.to_bits()) * 360_000 + (1 << 31)) >> 32) as i32
+            }),
+            ..self
         }
     }
 
@@ -87,6 +107,8 @@ impl Snapshot {
             overruns,
             lost_telemetry,
             latched_fault: self.latched_fault,
+            lock: self.lock,
+            phase_mdeg: self.phase_mdeg,
         }
     }
 

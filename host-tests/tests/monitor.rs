@@ -201,6 +201,8 @@ impl Firmware {
                     overruns: self.overruns,
                     lost_telemetry: self.lost,
                     latched_fault: None,
+                    lock: Some("pinned"),
+                    phase_mdeg: None,
                 },
                 out,
             ),

@@ -60,6 +60,12 @@ fn shift(errors: Errors<'_>, raw: Option<&RawShift>) -> Result<ResonanceShift, S
             freq_auto: false,
         });
     };
+    if raw.freq_auto == Some(true) && raw.bvd_envelope != Some(true) {
+        return Err(errors.at(
+            "transducer.shift.freq_auto",
+            "freq_auto needs bvd_envelope = true (only that plant samples its drive current)",
+        ));
+    }
     Ok(ResonanceShift {
         thermal_per_k: errors.within(
             "transducer.shift.thermal_per_k",

@@ -175,6 +175,10 @@ impl<'a> ClosedLoop<'a> {
         mode: Mode,
     ) -> Result<Self, SimError> {
         let plant = Plant::from_scene(scene).map_err(SimError::Plant)?;
+        if scene.transducer.shift.bvd_envelope {
+            // This plant samples its drive current every PWM period (`plant::transducer`).
+            station.enable_current_sense();
+        }
         let seed = scene.noise_seed;
         let (normal, tangential) = station.channels_mut();
         commission(normal, &scene.normal_cell, calibration, seed, 0)?;

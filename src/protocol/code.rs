@@ -136,6 +136,7 @@ mod tests {
             (22, "fault-latched"),
             (23, "no-target"),
             (24, "cal-failed"),
+            (25, "unavailable"),
         ];
         assert_eq!(ErrorCode::ALL.len(), expected.len());
         for (code, (number, name)) in ErrorCode::ALL.into_iter().zip(expected) {

@@ -96,6 +96,7 @@
 //! | 22 | `fault-latched` | a fault is latched; send `clear` first |
 //! | 23 | `no-target` | `start` without a target |
 //! | 24 | `cal-failed` | the calibration could not be completed |
+//! | 25 | `unavailable` | the command exists but this loop cannot do it (`freq auto` on a board that does not sample the drive current); the message says why |
 //!
 //! Codes 1 to 13 come from this module; codes 20 to 24 are for the firmware to return when a
 //! well-formed command cannot be executed. A code never changes meaning; new codes get new

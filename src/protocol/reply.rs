@@ -268,6 +268,10 @@ mod tests {
             ProtocolError::CalFailed {
                 reason: long_reason,
             },
+            ProtocolError::Unavailable {
+                command: "freq",
+                reason: long_reason,
+            },
         ];
         assert_eq!(errors.len(), ErrorCode::ALL.len());
         let mut out = Line::new();
