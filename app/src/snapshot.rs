@@ -33,8 +33,9 @@ pub struct Snapshot {
     pub control_cycles: u32,
     /// The resonance loop's state word, if the station has a loop.
     pub lock: Option<&'static str>,
-    /// The motional current's phase to the voltage, millidegrees; `None` when undefined.
-    pub phase_mdeg: Option<i32>,
+    /// The motional current (its phase to the voltage is the tracker's phase error; turned
+    /// into degrees only for `status`); `None` when undefined.
+    pub motional: Option<sonolube::resonance::Phasor>,
 }
 
 impl Snapshot {
@@ -52,7 +53,7 @@ impl Snapshot {
         active_fault: None,
         control_cycles: 0,
         lock: None,
-        phase_mdeg: None,
+        motional: None,
     };
 
     /// The snapshot of a controller `output`, with the loop's other facts.
@@ -77,7 +78,7 @@ impl Snapshot {
             active_fault,
             control_cycles,
             lock: None,
-            phase_mdeg: None,
+            motional: None,
         }
     }
 
@@ -85,10 +86,7 @@ impl Snapshot {
     pub fn with_resonance(self, report: Option<sonolube::resonance::ResonanceReport>) -> Self {
         Snapshot {
             lock: report.map(|r| r.state.name()),
-            phase_mdeg: report.and_then(|r| r.phase).map(|phase| {
-                // 360 000 mdeg per 2^32: |result| <= 180 000.
-                ((i64::from(phase.to_bits()) * 360_000 + (1 << 31)) >> 32) as i32
-            }),
+            motional: report.and_then(|r| r.motional),
             ..self
         }
     }
@@ -108,7 +106,10 @@ impl Snapshot {
             lost_telemetry,
             latched_fault: self.latched_fault,
             lock: self.lock,
-            phase_mdeg: self.phase_mdeg,
+            phase_mdeg: self.motional.map(|m| {
+                // 360 000 mdeg per 2^32: |result| <= 180 000.
+                ((i64::from(m.polar().phase.to_bits()) * 360_000 + (1 << 31)) >> 32) as i32
+            }),
         }
     }
 

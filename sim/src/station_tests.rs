@@ -215,7 +215,7 @@ fn freq_auto_searches_at_start_then_tracks_and_freq_pins() {
         record.resonance_hz
     );
     assert!(
-        run.station().resonance().expect("a loop").phase.is_some(),
+        run.station().resonance().expect("a loop").phase().is_some(),
         "a phase error is reported"
     );
     assert_eq!(

@@ -38,7 +38,7 @@
 use super::error::{ResonanceError, ResonanceFault};
 use super::lockin::{Demodulated, LockIn, LockInConfig};
 use super::motional::detuning;
-use super::phasor::Angle;
+use super::phasor::{Angle, Phasor};
 use super::search::{Search, SearchConfig, SearchSettings, SearchStep};
 use super::stack::{StackModel, StackSettings};
 use super::tracker::{Tracker, TrackerConfig, TrackerSettings};
@@ -137,11 +137,19 @@ pub struct ResonanceReport {
     pub state: LockState,
     /// The drive frequency in force.
     pub frequency: Frequency,
-    /// The motional current's phase to the voltage (the phase error; zero on resonance);
-    /// `None` before the first window with current.
-    pub phase: Option<Angle>,
+    /// The motional current relative to the voltage, full scale; its phase is the phase error
+    /// (zero on resonance, [`Self::phase`]); `None` before the first window with current.
+    pub motional: Option<Phasor>,
     /// The motional detuning `(f - f0) / (f0 / 2Q)`, half-bandwidths; `None` as `phase`.
     pub detuning: Option<Q8_24>,
+}
+
+impl ResonanceReport {
+    /// The phase error: the motional current's phase to the voltage (a CORDIC, for reports);
+    /// `None` when no window with current was measured.
+    pub fn phase(&self) -> Option<Angle> {
+        self.motional.map(|m| m.polar().phase)
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -203,7 +211,7 @@ impl ResonanceLoop {
             report: ResonanceReport {
                 state: LockState::Pinned,
                 frequency: tuning.frequency,
-                phase: None,
+                motional: None,
                 detuning: None,
             },
         })
@@ -219,7 +227,7 @@ impl ResonanceLoop {
         self.report = ResonanceReport {
             state: LockState::Pinned,
             frequency: tuning.frequency,
-            phase: None,
+            motional: None,
             detuning: None,
         };
         Ok(())
@@ -236,7 +244,7 @@ impl ResonanceLoop {
         self.report = ResonanceReport {
             state: LockState::Searching,
             frequency: tuning.frequency,
-            phase: None,
+            motional: None,
             detuning: None,
         };
         Ok(())
@@ -316,7 +324,7 @@ impl ResonanceLoop {
                         LockState::Tracking
                     };
                     if amplitude != Amplitude::ZERO {
-                        self.report.phase = Some(status.motional.phase);
+                        self.report.motional = Some(status.motional);
                         self.report.detuning = Some(status.detuning);
                     }
                     if *unlocked >= LOST_WINDOWS {
@@ -349,8 +357,7 @@ impl ResonanceLoop {
 
     /// Pinned: the motional current's phase and detuning, for the report only.
     fn measure(&mut self, window: &Demodulated, amplitude: Amplitude) {
-        if amplitude == Amplitude::ZERO
-            || window.phasor.polar().amplitude < self.stack.min_current(amplitude)
+        if amplitude == Amplitude::ZERO || window.phasor.is_below(self.stack.min_current(amplitude))
         {
             return;
         }
@@ -358,7 +365,7 @@ impl ResonanceLoop {
             self.stack
                 .capacitance()
                 .motional(window.phasor, self.tuning.frequency, amplitude);
-        self.report.phase = Some(motional.polar().phase);
+        self.report.motional = Some(motional);
         self.report.detuning = Some(detuning(motional));
     }
 }
