@@ -96,6 +96,8 @@ fn resonance_search_locks_then_reaches_the_target() {
     // Pinned 8 % off, the stack cannot make the vibration: the target is out of reach.
     assert!(off.worst_gain < 0.1, "{off:?}");
     assert!(!off.verdict && off.rms_error_pct > 10.0, "{off:?}");
+    // ... though the friction loop drives at its ceiling all the while.
+    assert!(off.mean_drive > 0.99, "{off:?}");
 }
 
 #[test]
