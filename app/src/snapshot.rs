@@ -3,7 +3,7 @@
 
 use sonolube::control::Output;
 use sonolube::fx::{Q1_31, Q2_30, Q16_16};
-use sonolube::protocol::{StatusReport, SupervisorState, Target, TelemetryRecord};
+use sonolube::protocol::{Lock, StatusReport, SupervisorState, Target, TelemetryRecord};
 
 /// The loop after a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, defmt::Format)]
@@ -31,8 +31,8 @@ pub struct Snapshot {
     /// Board cycles the step's control part took (sense, estimate, model, control, drive
     /// command), in the board's cycle clock ([`crate::control::ControlLoop::CYCLE_HZ`]).
     pub control_cycles: u32,
-    /// The resonance loop's state word, if the station has a loop.
-    pub lock: Option<&'static str>,
+    /// The resonance loop's state, if the station has a loop.
+    pub lock: Option<Lock>,
     /// The motional current (its phase to the voltage is the tracker's phase error; turned
     /// into degrees only for `status`); `None` when undefined.
     pub motional: Option<sonolube::resonance::Phasor>,
@@ -85,7 +85,7 @@ impl Snapshot {
     /// This snapshot with the station's resonance report (`None`: no loop).
     pub fn with_resonance(self, report: Option<sonolube::resonance::ResonanceReport>) -> Self {
         Snapshot {
-            lock: report.map(|r| r.state.name()),
+            lock: report.map(|r| Lock::from(r.state)),
             motional: report.and_then(|r| r.motional),
             ..self
         }
@@ -105,11 +105,8 @@ impl Snapshot {
             overruns,
             lost_telemetry,
             latched_fault: self.latched_fault,
-            lock: self.lock,
-            phase_mdeg: self.motional.map(|m| {
-                // 360 000 mdeg per 2^32: |result| <= 180 000.
-                ((i64::from(m.polar().phase.to_bits()) * 360_000 + (1 << 31)) >> 32) as i32
-            }),
+            lock: self.lock.map(Lock::name),
+            phase_mdeg: self.phase_mdeg(),
         }
     }
 
@@ -127,7 +124,17 @@ impl Snapshot {
             drive_freq_chz: self.drive_freq_chz,
             overruns,
             lost_records: lost,
+            lock: self.lock,
+            phase_mdeg: self.phase_mdeg(),
         }
+    }
+
+    /// The phase error in mdeg (a CORDIC: for reports only, not per step).
+    fn phase_mdeg(&self) -> Option<i32> {
+        self.motional.map(|m| {
+            // 360 000 mdeg per 2^32: |result| <= 180 000.
+            ((i64::from(m.polar().phase.to_bits()) * 360_000 + (1 << 31)) >> 32) as i32
+        })
     }
 }
 

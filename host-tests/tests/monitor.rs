@@ -117,6 +117,8 @@ impl Firmware {
             drive_freq_chz: self.freq_chz,
             overruns: self.overruns,
             lost_records: self.lost,
+            lock: None,
+            phase_mdeg: None,
         }
     }
 

@@ -136,6 +136,8 @@ mod tests {
             drive_freq_chz: 0,
             overruns: 0,
             lost_records: lost,
+            lock: None,
+            phase_mdeg: None,
         }
     }
 

@@ -203,6 +203,8 @@ mod tests {
             drive_freq_chz: 4_000_000,
             overruns: 0,
             lost_records: 0,
+            lock: None,
+            phase_mdeg: None,
         }
     }
 
