@@ -24,10 +24,13 @@
 //! reads its simulated cells under the load the command names.
 
 use crate::control::{
-    Config, ConfigError, Controller, Inputs, Output, Sensor, SensorFault, SensorFaultKind, Settings,
+    Config, ConfigError, Controller, ExternalFault, Inputs, Output, Sensor, SensorFault,
+    SensorFaultKind, Settings,
 };
-use crate::fx::{Q8_24, Q16_16};
+use crate::drive::{Amplitude, Frequency, TimerClock};
+use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
 use crate::model::{AnyModel, ModelError};
+use crate::resonance::{ResonanceLoop, ResonanceReport, ResonanceSettings, StackSettings};
 use core::fmt::Write;
 
 use crate::protocol::DRIVE_FREQ;
@@ -98,7 +101,34 @@ pub struct Station {
     drive_hz: f32,
     /// The same frequency in the protocol's cHz, for reports (set with `drive_hz`).
     drive_freq_chz: u32,
+    /// The resonance loop (`freq auto`, `freq HZ`); `None` when the scene's stack is outside
+    /// what it can model (the reason is in `resonance_refused`).
+    resonance: Option<ResonanceLoop>,
+    resonance_refused: &'static str,
+    /// `freq auto` given while the drive was off: the next `start` searches first.
+    auto_armed: bool,
+    /// A `start` waits for the search to lock.
+    start_pending: bool,
+    /// The board feeds current samples ([`Self::enable_current_sense`]): `freq auto` is
+    /// possible.
+    current_sense: bool,
+    /// The drive amplitude the station returned last (what the drive applies over the
+    /// period whose current samples come next).
+    applied: Amplitude,
 }
+
+/// The current sense the station assumes for the resonance loop: the NUCLEO-G474RE's
+/// (25 mOhm shunt, INA240A1 at 20 V/V, 3.3 V converter span: 6.6 A per full scale; the QEMU
+/// board's simulated sense is the same).
+pub const CURRENT_SENSE_A_PER_FULL_SCALE: f64 = 6.6;
+
+/// The timer the resonance loop's frequencies are rounded to (TIM1 of the G474 at 170 MHz;
+/// the QEMU board's simulated drive uses the same grid).
+pub const DRIVE_CLOCK: TimerClock = TimerClock::G474_TIM1;
+
+/// Most current samples one [`Station::push_current`] call takes (one per PWM period of a
+/// control period: 6 at 60 kHz and 10 kHz).
+pub const MAX_CURRENT_SAMPLES: usize = 16;
 
 impl Station {
     /// The station of `scene`: the controller model [`select`] chooses for it (built with
@@ -152,6 +182,17 @@ impl Station {
         tangential: SensorChannel,
     ) -> Result<Self, StationError> {
         let controller = Controller::new(Config::new(settings).map_err(StationError::Config)?);
+        let stack = StackSettings {
+            resonance_hz: scene.transducer.resonance_hz,
+            quality_factor: scene.transducer.quality_factor,
+            clamped_capacitance_f: scene.transducer.clamped_capacitance_f,
+            full_scale_voltage_v: scene.actuator.full_scale_voltage_v,
+            amperes_per_full_scale: CURRENT_SENSE_A_PER_FULL_SCALE,
+            min_admittance_s: StackSettings::REFERENCE.min_admittance_s,
+        };
+        let start = Frequency::from_millihertz(libm::round(scene.transducer.drive_hz * 1e3) as u32);
+        let resonance =
+            ResonanceLoop::new(&ResonanceSettings::around(&stack), start, DRIVE_CLOCK).ok();
         Ok(Self {
             model,
             selection,
@@ -161,7 +202,61 @@ impl Station {
             drive_hz: scene.transducer.drive_hz as f32,
             // Scene drive frequencies are validated to 20-60 kHz: the cast cannot wrap.
             drive_freq_chz: libm::round(scene.transducer.drive_hz * 100.0) as u32,
+            resonance_refused: if resonance.is_some() {
+                ""
+            } else {
+                "the stack's current is beyond the current sense or its data out of range"
+            },
+            resonance,
+            auto_armed: false,
+            start_pending: false,
+            current_sense: false,
+            applied: Amplitude::ZERO,
         })
+    }
+
+    /// Declares that the board calls [`Self::push_current`] every period. Until then `freq
+    /// auto` is refused (`unavailable`): a search without samples would never end.
+    pub fn enable_current_sense(&mut self) {
+        self.current_sense = true;
+    }
+
+    /// The current samples (12-bit current-sense codes, mid-scale zero) taken synchronously
+    /// to the PWM over the last control period, one per PWM period, the trigger phase
+    /// advancing a quarter period each time (see [`crate::resonance::ResonanceLoop`]); call
+    /// it before [`Self::control`]. At most [`MAX_CURRENT_SAMPLES`] are taken (the rest are
+    /// ignored). When the loop loses the resonance (`freq auto`), the controller latches
+    /// `resonance-lost`: the next step drives zero.
+    pub fn push_current(&mut self, codes: &[u16]) {
+        let Some(resonance) = self.resonance.as_mut() else {
+            return;
+        };
+        let mut samples = [Q1_31::ZERO; MAX_CURRENT_SAMPLES];
+        let mut count = 0;
+        for (slot, &code) in samples.iter_mut().zip(codes) {
+            *slot = crate::resonance::current_sample(code);
+            count += 1;
+        }
+        let taken = samples.get(..count).unwrap_or(&[]);
+        if resonance.push(taken, self.applied).is_err() {
+            self.start_pending = false;
+            self.controller.trip(ExternalFault::ResonanceLost);
+        }
+        // `freq auto` moves the drive; pinned, the frequency is the one `freq` set.
+        if resonance.report().state != crate::resonance::LockState::Pinned {
+            let millihertz = resonance.tuning().frequency.millihertz();
+            let chz = millihertz / 10 + u32::from(millihertz % 10 >= 5);
+            if chz != self.drive_freq_chz {
+                self.drive_freq_chz = chz;
+                self.drive_hz = millihertz as f32 / 1000.0;
+            }
+        }
+    }
+
+    /// The resonance loop's last report (mode, lock, frequency, phase error); `None` when
+    /// the scene's stack has no loop.
+    pub fn resonance(&self) -> Option<ResonanceReport> {
+        self.resonance.as_ref().map(ResonanceLoop::report)
     }
 
     /// One control period: the codes through the sensing chain (format, fault checks,
@@ -182,7 +277,35 @@ impl Station {
             sliding_velocity: Q8_24::from_f32_saturating(sample.sliding_velocity_m_per_s).value,
             sensor_fault,
         };
-        let output = self.controller.step(&inputs, &self.model);
+        let mut output = self.controller.step(&inputs, &self.model);
+        if let Some(resonance) = self.resonance.as_ref() {
+            let drive_allowed = output.fault.is_none()
+                && (self.start_pending
+                    || matches!(
+                        output.state,
+                        crate::protocol::SupervisorState::RampUp
+                            | crate::protocol::SupervisorState::Running
+                    ));
+            if resonance.is_searching() {
+                // The search drives its own low amplitude; the friction loop waits (a
+                // pending `start`) or keeps its supervision while its command is replaced.
+                output.amplitude = if drive_allowed {
+                    search_command(resonance.search_amplitude())
+                } else {
+                    Q1_31::ZERO
+                };
+            } else if self.start_pending {
+                self.start_pending = false;
+                // Locked: the friction loop starts at the found frequency, with the current
+                // rating's ceiling there. Both were checked when `start` was accepted.
+                let hz = f64::from(resonance.tuning().frequency.millihertz()) / 1000.0;
+                if let Ok(config) = self.controller.config().at_drive_frequency(hz) {
+                    self.controller.reconfigure(config);
+                }
+                let _ = self.controller.start();
+            }
+        }
+        self.applied = drive_amplitude(output.amplitude);
         Control {
             output,
             sensor_fault,
@@ -201,8 +324,57 @@ impl Station {
         let refused = |e: crate::control::ControlError| e.to_protocol();
         match *command {
             Command::Target(target) => self.controller.set_target(target).map_err(refused),
+            Command::Start if self.auto_armed => {
+                // Refused for the controller's reasons (no target, fault latched) before
+                // anything changes; accepted, the search runs first and the friction loop
+                // starts at its lock.
+                let mut probe = self.controller;
+                probe.start().map_err(refused)?;
+                let resonance = self.resonance.as_mut().ok_or(ProtocolError::Unavailable {
+                    command: command.keyword(),
+                    reason: self.resonance_refused,
+                })?;
+                resonance.search().map_err(|_| ProtocolError::Unavailable {
+                    command: command.keyword(),
+                    reason: "the timer cannot make the search's frequencies",
+                })?;
+                self.auto_armed = false;
+                self.start_pending = true;
+                Ok(())
+            }
             Command::Start => self.controller.start().map_err(refused),
+            Command::Stop if self.start_pending => {
+                // The search stops where it is, pinned; the friction loop never started.
+                self.start_pending = false;
+                self.auto_armed = true;
+                self.pin_here();
+                Ok(())
+            }
             Command::Stop => self.controller.stop().map_err(refused),
+            Command::FreqAuto => {
+                if !self.current_sense {
+                    return Err(ProtocolError::Unavailable {
+                        command: command.keyword(),
+                        reason: "this board does not sample the drive current",
+                    });
+                }
+                let resonance = self.resonance.as_mut().ok_or(ProtocolError::Unavailable {
+                    command: command.keyword(),
+                    reason: self.resonance_refused,
+                })?;
+                match self.controller.state() {
+                    crate::protocol::SupervisorState::RampUp
+                    | crate::protocol::SupervisorState::Running => {
+                        resonance.search().map_err(|_| ProtocolError::Unavailable {
+                            command: command.keyword(),
+                            reason: "the timer cannot make the search's frequencies",
+                        })?;
+                    }
+                    // Drive off: the search runs at the next `start`.
+                    _ => self.auto_armed = true,
+                }
+                Ok(())
+            }
             Command::Clear => self.controller.clear_fault().map_err(refused),
             Command::Freq { freq_chz } => {
                 if !FREQ_RANGE_CHZ.contains(&freq_chz) {
@@ -222,9 +394,29 @@ impl Station {
                         token: freq_token(freq_chz),
                         quantity: &DRIVE_FREQ,
                     })?;
+                // Pinned on the timer's grid: the frequency reported is the one the timer
+                // makes (within 0.6 Hz of the command near 40 kHz).
+                let mut pinned = None;
+                if let Some(resonance) = self.resonance.as_mut() {
+                    let mut candidate = resonance.clone();
+                    if candidate
+                        .pin(Frequency::from_millihertz(freq_chz * 10))
+                        .is_ok()
+                    {
+                        pinned = Some(candidate);
+                    }
+                }
                 self.controller.reconfigure(config);
                 self.drive_hz = freq_chz as f32 / 100.0;
                 self.drive_freq_chz = freq_chz;
+                if let Some(pinned) = pinned {
+                    self.resonance = Some(pinned);
+                }
+                self.auto_armed = false;
+                if self.start_pending {
+                    self.start_pending = false;
+                    let _ = self.controller.start();
+                }
                 Ok(())
             }
             Command::Tare(axes) => {
@@ -286,6 +478,14 @@ impl Station {
         }
     }
 
+    /// Pins the resonance loop at its present frequency (a cancelled search).
+    fn pin_here(&mut self) {
+        if let Some(resonance) = self.resonance.as_mut() {
+            let here = resonance.tuning().frequency;
+            let _ = resonance.pin(here);
+        }
+    }
+
     fn require_drive_off(&self, command: &Command) -> Result<(), ProtocolError> {
         match self.state() {
             SupervisorState::Idle | SupervisorState::Fault | SupervisorState::Boot => Ok(()),
@@ -342,6 +542,19 @@ impl Station {
     pub fn channels_mut(&mut self) -> (&mut SensorChannel, &mut SensorChannel) {
         (&mut self.normal, &mut self.tangential)
     }
+}
+
+/// The controller's Q1.31 command for the search's amplitude (at most 1, which Q1.31 holds as
+/// its largest value).
+fn search_command(amplitude: Amplitude) -> Q1_31 {
+    let bits = i64::from(amplitude.bits()) << 1;
+    Q1_31::from_bits(bits.min(i64::from(i32::MAX)) as i32)
+}
+
+/// The drive amplitude of a controller command (Q1.31 in [0, 1) to Q2.30; negative as zero).
+fn drive_amplitude(command: Q1_31) -> Amplitude {
+    let bits = command.to_bits().max(0) >> 1;
+    Amplitude::new(Q2_30::from_bits(bits)).unwrap_or(Amplitude::ZERO)
 }
 
 /// A drive frequency in cHz as the protocol writes it (`39500.50`), for an error reply.

@@ -3,7 +3,7 @@
 
 use sonolube::control::Output;
 use sonolube::fx::{Q1_31, Q2_30, Q16_16};
-use sonolube::protocol::{LoopReading, StatusReport, Target, TelemetryRecord};
+use sonolube::protocol::{Lock, LoopReading, StatusReport, Target, TelemetryRecord};
 
 /// The loop after a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, defmt::Format)]
@@ -19,6 +19,11 @@ pub struct Snapshot {
     /// Board cycles the step's control part took (sense, estimate, model, control, drive
     /// command), in the board's cycle clock ([`crate::control::ControlLoop::CYCLE_HZ`]).
     pub control_cycles: u32,
+    /// The resonance loop's state, if the station has a loop.
+    pub lock: Option<Lock>,
+    /// The motional current (its phase to the voltage is the tracker's phase error; turned
+    /// into degrees only for `status`); `None` when undefined.
+    pub motional: Option<sonolube::resonance::Phasor>,
 }
 
 impl Snapshot {
@@ -29,6 +34,8 @@ impl Snapshot {
         latched_fault: None,
         active_fault: None,
         control_cycles: 0,
+        lock: None,
+        motional: None,
     };
 
     /// The snapshot of a controller `output`, with the loop's other facts.
@@ -54,6 +61,17 @@ impl Snapshot {
             latched_fault: output.fault.map(|reason| reason.name()),
             active_fault,
             control_cycles,
+            lock: None,
+            motional: None,
+        }
+    }
+
+    /// This snapshot with the station's resonance report (`None`: no loop).
+    pub fn with_resonance(self, report: Option<sonolube::resonance::ResonanceReport>) -> Self {
+        Snapshot {
+            lock: report.map(|r| Lock::from(r.state)),
+            motional: report.and_then(|r| r.motional),
+            ..self
         }
     }
 
@@ -65,6 +83,8 @@ impl Snapshot {
             overruns,
             lost_telemetry,
             latched_fault: self.latched_fault,
+            lock: self.lock.map(Lock::name),
+            phase_mdeg: self.phase_mdeg(),
         }
     }
 
@@ -76,7 +96,17 @@ impl Snapshot {
             reading: self.reading,
             overruns,
             lost_records: lost,
+            lock: self.lock,
+            phase_mdeg: self.phase_mdeg(),
         }
+    }
+
+    /// The phase error in mdeg (a CORDIC: for reports only, not per step).
+    fn phase_mdeg(&self) -> Option<i32> {
+        self.motional.map(|m| {
+            // 360 000 mdeg per 2^32: |result| <= 180 000.
+            ((i64::from(m.polar().phase.to_bits()) * 360_000 + (1 << 31)) >> 32) as i32
+        })
     }
 }
 

@@ -155,7 +155,8 @@ pub struct OutOfReach {
 
 /// The instants, every `every_s` along the scene, where its plant model cannot bring the
 /// friction down to the target with `amplitude` (fraction of full command, (0, 1]) times the
-/// transducer's gain at the drive frequency then (the resonance may have drifted). Instants
+/// transducer's gain at the drive frequency then (the resonance may have drifted; a `freq
+/// auto` scene drives on the resonance). Instants
 /// where the sliding speed is below 2 % of the scene's largest (a reversal: the ratio is not
 /// defined there) are skipped. Errors: the plant model cannot be built or evaluated.
 pub fn out_of_reach(
@@ -182,7 +183,15 @@ pub fn out_of_reach(
         }
         let transducer = &scene.transducer;
         let f0 = transducer.resonance_hz + transducer.drift_hz_per_s * f64::from(t_s);
-        let detuning = 2.0 * transducer.quality_factor * (transducer.drive_hz - f0) / f0;
+        // A `freq auto` scene keeps the drive on the resonance (it is judged after the lock);
+        // otherwise the drive stays at the scene's frequency. (The self-heating and load shifts
+        // of `[transducer.shift]` are not modelled here: only the linear drift.)
+        let drive_hz = if transducer.shift.freq_auto {
+            f0
+        } else {
+            transducer.drive_hz
+        };
+        let detuning = 2.0 * transducer.quality_factor * (drive_hz - f0) / f0;
         let gain = 1.0 / (1.0 + detuning * detuning).sqrt();
         let point = OperatingPoint {
             normal_force: Q16_16::from_f32_saturating(interpolate(scene.normal_load_n, t_s)).value,
@@ -270,6 +279,14 @@ fn transducer(t: &toml_scene::Transducer) -> Transducer {
         drive_hz: t.drive_hz,
         clamped_capacitance_f: t.clamped_capacitance_f,
         motional_resistance_ohm: t.motional_resistance_ohm,
+        shift: sonolube::scene::ResonanceShift {
+            thermal_per_k: t.shift.thermal_per_k,
+            thermal_resistance_k_per_w: t.shift.thermal_resistance_k_per_w,
+            thermal_time_constant_s: t.shift.thermal_time_constant_s,
+            load_per_n: t.shift.load_per_n,
+            bvd_envelope: t.shift.bvd_envelope,
+            freq_auto: t.shift.freq_auto,
+        },
     }
 }
 

@@ -120,6 +120,8 @@ impl Firmware {
             },
             overruns: self.overruns,
             lost_records: self.lost,
+            lock: None,
+            phase_mdeg: None,
         }
     }
 
@@ -206,6 +208,8 @@ impl Firmware {
                     overruns: self.overruns,
                     lost_telemetry: self.lost,
                     latched_fault: None,
+                    lock: Some("pinned"),
+                    phase_mdeg: None,
                 },
                 out,
             ),

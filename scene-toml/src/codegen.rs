@@ -169,13 +169,21 @@ fn horn(h: &Horn) -> String {
 fn transducer(t: &Transducer) -> String {
     format!(
         "Transducer {{ resonance_hz: {}, quality_factor: {}, drift_hz_per_s: {}, drive_hz: {}, \
-         clamped_capacitance_f: {}, motional_resistance_ohm: {} }}",
+         clamped_capacitance_f: {}, motional_resistance_ohm: {}, shift: ResonanceShift {{ \
+         thermal_per_k: {}, thermal_resistance_k_per_w: {}, thermal_time_constant_s: {}, \
+         load_per_n: {}, bvd_envelope: {}, freq_auto: {} }} }}",
         num(t.resonance_hz),
         num(t.quality_factor),
         num(t.drift_hz_per_s),
         num(t.drive_hz),
         num(t.clamped_capacitance_f),
         num(t.motional_resistance_ohm),
+        num(t.shift.thermal_per_k),
+        num(t.shift.thermal_resistance_k_per_w),
+        num(t.shift.thermal_time_constant_s),
+        num(t.shift.load_per_n),
+        t.shift.bvd_envelope,
+        t.shift.freq_auto,
     )
 }
 

@@ -1,8 +1,8 @@
 //! The hardware sections of a scene file: transducer, actuator, horn and load cells.
 
 use crate::error::{Errors, SceneError};
-use crate::raw::{RawActuator, RawCell, RawHorn, RawTransducer};
-use crate::types::{Actuator, ActuatorKind, Horn, LoadCell, Stack, Transducer};
+use crate::raw::{RawActuator, RawCell, RawHorn, RawShift, RawTransducer};
+use crate::types::{Actuator, ActuatorKind, Horn, LoadCell, ResonanceShift, Stack, Transducer};
 use crate::validate::{DEFAULT_ADC_BITS, DRIVE_RANGE_HZ};
 
 pub(crate) fn transducer(
@@ -45,6 +45,53 @@ pub(crate) fn transducer(
             raw.motional_resistance_ohm,
             1e5,
         )?,
+        shift: shift(errors, raw.shift.as_ref())?,
+    })
+}
+
+fn shift(errors: Errors<'_>, raw: Option<&RawShift>) -> Result<ResonanceShift, SceneError> {
+    let Some(raw) = raw else {
+        return Ok(ResonanceShift {
+            thermal_per_k: 0.0,
+            thermal_resistance_k_per_w: 0.0,
+            thermal_time_constant_s: 1.0,
+            load_per_n: 0.0,
+            bvd_envelope: false,
+            freq_auto: false,
+        });
+    };
+    if raw.freq_auto == Some(true) && raw.bvd_envelope != Some(true) {
+        return Err(errors.at(
+            "transducer.shift.freq_auto",
+            "freq_auto needs bvd_envelope = true (only that plant samples its drive current)",
+        ));
+    }
+    Ok(ResonanceShift {
+        thermal_per_k: errors.within(
+            "transducer.shift.thermal_per_k",
+            raw.thermal_per_k.unwrap_or(0.0),
+            -1e-2,
+            1e-2,
+        )?,
+        thermal_resistance_k_per_w: errors.within(
+            "transducer.shift.thermal_resistance_k_per_w",
+            raw.thermal_resistance_k_per_w.unwrap_or(0.0),
+            0.0,
+            1e3,
+        )?,
+        thermal_time_constant_s: errors.positive(
+            "transducer.shift.thermal_time_constant_s",
+            raw.thermal_time_constant_s.unwrap_or(1.0),
+            1e4,
+        )?,
+        load_per_n: errors.within(
+            "transducer.shift.load_per_n",
+            raw.load_per_n.unwrap_or(0.0),
+            -1e-2,
+            1e-2,
+        )?,
+        bvd_envelope: raw.bvd_envelope.unwrap_or(false),
+        freq_auto: raw.freq_auto.unwrap_or(false),
     })
 }
 

@@ -104,6 +104,19 @@ pub(crate) struct RawTransducer {
     pub drive_hz: Option<f64>,
     pub clamped_capacitance_f: f64,
     pub motional_resistance_ohm: f64,
+    pub shift: Option<RawShift>,
+}
+
+/// `[transducer.shift]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawShift {
+    pub thermal_per_k: Option<f64>,
+    pub thermal_resistance_k_per_w: Option<f64>,
+    pub thermal_time_constant_s: Option<f64>,
+    pub load_per_n: Option<f64>,
+    pub bvd_envelope: Option<bool>,
+    pub freq_auto: Option<bool>,
 }
 
 /// `[sensors]`.

@@ -162,6 +162,25 @@ pub struct Transducer {
     pub clamped_capacitance_f: f64,
     /// Motional resistance R1, ohm.
     pub motional_resistance_ohm: f64,
+    /// Resonance shift and loop (`[transducer.shift]`).
+    pub shift: ResonanceShift,
+}
+
+/// `[transducer.shift]`: see `sonolube::scene::ResonanceShift`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ResonanceShift {
+    /// Relative f0 change per kelvin, 1/K.
+    pub thermal_per_k: f64,
+    /// Thermal resistance, K/W.
+    pub thermal_resistance_k_per_w: f64,
+    /// Thermal time constant, s.
+    pub thermal_time_constant_s: f64,
+    /// Relative f0 change per newton of normal load above the initial load, 1/N.
+    pub load_per_n: f64,
+    /// Complex (BVD) envelope and PWM-synchronous current samples.
+    pub bvd_envelope: bool,
+    /// `freq auto` before the start.
+    pub freq_auto: bool,
 }
 
 /// A load cell and its converter channel.

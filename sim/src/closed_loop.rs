@@ -64,6 +64,10 @@ pub struct StepRecord {
     pub sensor_fault: Option<SensorFault>,
     /// A scene fault acts on this sample (either cell).
     pub injected_fault: bool,
+    /// The drive frequency over the step, Hz.
+    pub drive_hz: f32,
+    /// The transducer's resonance f0 at the sample, Hz.
+    pub resonance_hz: f32,
 }
 
 /// Where the loop is within a period.
@@ -156,7 +160,17 @@ impl<'a> ClosedLoop<'a> {
         controller
             .set_target(first.target)
             .map_err(SimError::Control)?;
-        controller.start().map_err(SimError::Control)?;
+        if scene.transducer.shift.freq_auto {
+            // `freq auto` then `start`, as an operator would: the search runs first and the
+            // friction loop starts at its lock.
+            let mut bench = SimulatedCells { scene, burst: 0 };
+            run.station
+                .execute(&Command::FreqAuto, &mut bench)
+                .and_then(|()| run.station.execute(&Command::Start, &mut bench))
+                .map_err(SimError::Resonance)?;
+        } else {
+            controller.start().map_err(SimError::Control)?;
+        }
         Ok(run)
     }
 
@@ -174,6 +188,10 @@ impl<'a> ClosedLoop<'a> {
         mode: Mode,
     ) -> Result<Self, SimError> {
         let plant = Plant::from_scene(scene).map_err(SimError::Plant)?;
+        if scene.transducer.shift.bvd_envelope {
+            // This plant samples its drive current every PWM period (`plant::transducer`).
+            station.enable_current_sense();
+        }
         let seed = scene.noise_seed;
         let (normal, tangential) = station.channels_mut();
         commission(normal, &scene.normal_cell, calibration, seed, 0)?;
@@ -237,6 +255,11 @@ impl<'a> ClosedLoop<'a> {
             // interpolates between two of them: the command is accepted.
             let _ = self.station.controller_mut().set_target(target);
         }
+        let count = usize::from(readings.current_count);
+        if count > 0 {
+            self.station
+                .push_current(readings.current_codes.get(..count).unwrap_or(&[]));
+        }
         let control = self.station.control(&Sample {
             normal_code: readings.normal_code,
             tangential_code: readings.tangential_code,
@@ -290,6 +313,8 @@ impl<'a> ClosedLoop<'a> {
             at_limit,
             sensor_fault,
             injected_fault: truth.normal_fault.is_some() || truth.tangential_fault.is_some(),
+            drive_hz: truth.drive_hz,
+            resonance_hz: truth.resonance_hz,
         })
     }
 

@@ -38,6 +38,9 @@ impl fmt::Display for SimError {
                 f,
                 "more than {MAX_CRITERIA} criteria or {MAX_FAULTS} faults (the runner's capacity)"
             ),
+            Self::Resonance(error) => {
+                write!(f, "the scene's resonance loop refused its start: {error:?}")
+            }
         }
     }
 }

@@ -80,6 +80,8 @@ pub enum SimError {
     InvalidTarget,
     /// More criteria or faults than the runner holds ([`MAX_CRITERIA`], [`MAX_FAULTS`]).
     TooLarge,
+    /// The scene asks for `freq auto` and the station refused it or the start after it.
+    Resonance(sonolube::protocol::ProtocolError),
 }
 
 impl From<StationError> for SimError {

@@ -159,3 +159,97 @@ fn a_drive_frequency_outside_the_range_is_refused_and_kept() {
         Some(ErrorCode::WrongState)
     );
 }
+
+/// `freq auto` on a plant without a sampled current is refused as `unavailable` with the
+/// reason, in every state (no longer the misleading `wrong-state ... in state idle`).
+#[test]
+fn freq_auto_without_current_samples_is_unavailable_and_says_why() {
+    let mut run = operated();
+    let error = run.execute(&Command::FreqAuto).unwrap_err();
+    assert_eq!(error.code(), ErrorCode::Unavailable);
+    let mut text: heapless::String<128> = heapless::String::new();
+    sonolube::protocol::format_error(&error, &mut text).unwrap();
+    assert!(
+        text.contains("freq is unavailable: this board does not sample the drive current"),
+        "{text}"
+    );
+}
+
+/// `freq auto` in idle arms the search; `start` runs it at its own amplitude with the friction
+/// loop waiting, the loop starts at the lock and the tracker keeps the drive on f0; `freq HZ`
+/// pins again.
+#[test]
+fn freq_auto_searches_at_start_then_tracks_and_freq_pins() {
+    let scene = find("resonance-search").expect("built in");
+    let mut run = ClosedLoop::operated(scene).expect("runs");
+    assert_eq!(run.execute(&Command::FreqAuto), Ok(()));
+    let lock = |run: &ClosedLoop<'_>| run.station().resonance().expect("a loop").state;
+    assert_eq!(lock(&run), sonolube::resonance::LockState::Pinned);
+    assert_eq!(
+        run.execute(&Command::Target(Target::Reduction {
+            reduction_mpct: 40_000
+        })),
+        Ok(())
+    );
+    assert_eq!(run.execute(&Command::Start), Ok(()));
+    let mut searched = 0;
+    let mut record = run.step().expect("never finishes");
+    while lock(&run) == sonolube::resonance::LockState::Searching {
+        // The friction loop waits, the search drives a tenth of full scale.
+        assert_eq!(record.state, SupervisorState::Idle);
+        assert!((record.drive_amplitude - 0.1).abs() < 1e-6);
+        searched += 1;
+        assert!(searched < 150, "no lock in 15 ms");
+        record = run.step().expect("never finishes");
+    }
+    for _ in 0..300 {
+        record = run.step().expect("never finishes");
+    }
+    assert_eq!(record.state, SupervisorState::Running);
+    assert_eq!(lock(&run), sonolube::resonance::LockState::Locked);
+    let offset = (record.drive_hz - record.resonance_hz).abs() / record.resonance_hz;
+    assert!(
+        offset < 5e-4,
+        "drive {} f0 {}",
+        record.drive_hz,
+        record.resonance_hz
+    );
+    assert!(
+        run.station().resonance().expect("a loop").phase().is_some(),
+        "a phase error is reported"
+    );
+    assert_eq!(
+        run.execute(&Command::Freq {
+            freq_chz: 3_900_000
+        }),
+        Ok(())
+    );
+    record = run.step().expect("never finishes");
+    assert_eq!(lock(&run), sonolube::resonance::LockState::Pinned);
+    assert_eq!(record.drive_hz, 39_000.0);
+}
+
+/// A tracker that loses the resonance latches `resonance-lost` (reason 23): the supervisor
+/// goes to `fault` and the drive to zero. Here the resonance leaves the tracker's band
+/// (+-10 % of nominal) at 1 %/s x 20: the tracker pins at its limit and faults.
+#[test]
+fn losing_the_resonance_latches_a_fault() {
+    let mut scene = *find("resonance-drift").expect("built in");
+    scene.transducer.drift_hz_per_s = 8_000.0;
+    scene.duration_s = 1.0;
+    let scene: &'static sonolube::scene::Scene<'static> = Box::leak(Box::new(scene));
+    let mut run = ClosedLoop::new(scene).expect("runs");
+    let mut fault = None;
+    while let Some(record) = run.step() {
+        if record.state == SupervisorState::Fault {
+            fault = Some(record);
+            break;
+        }
+    }
+    let record = fault.expect("the resonance left the band: a fault");
+    assert_eq!(record.reason, sonolube::control::Reason::ResonanceLost);
+    assert_eq!(record.reason.code(), 23);
+    assert_eq!(record.drive_amplitude, 0.0);
+    // The tracker's upper limit is 44 kHz (+10 %): the fault comes after f0 passes it.
+    assert!(record.resonance_hz > 44_000.0, "f0 {}", record.resonance_hz);
+}

@@ -50,6 +50,7 @@ impl Rig {
             drive_hz: 40_000.0,
             clamped_capacitance_f: 300e-9,
             motional_resistance_ohm: r1_ohm,
+            shift: sonolube::scene::ResonanceShift::NONE,
         };
         let actuator = Actuator {
             kind: ActuatorKind::PmnPtStack,

@@ -18,6 +18,7 @@
 //! | 20 | `overcurrent` | any -> fault (reported by the drive) |
 //! | 21 | `overrun` | any -> fault (the control step missed its period) |
 //! | 22 | `model-error` | any -> fault (the model could not be evaluated) |
+//! | 23 | `resonance-lost` | any -> fault (`freq auto`: the search failed, or the tracker lost the resonance; see `crate::resonance::ResonanceLoop`) |
 //! | 40-51 | `<sensor>-<kind>` | any -> fault: `40 + 4 sensor + kind`, sensor normal 0, tangential 1, velocity 2; kind disconnected 0, stuck 1, jump 2, out-of-range 3 (e.g. 41 `normal-stuck`, 47 `tangential-out-of-range`) |
 
 /// A sensor the controller reads.
@@ -64,6 +65,8 @@ pub enum ExternalFault {
     Overcurrent,
     /// The control step did not finish within its period.
     Overrun,
+    /// The resonance loop (`freq auto`) failed its search or lost the resonance.
+    ResonanceLost,
 }
 
 /// Why the supervisor is in its present state.
@@ -92,6 +95,8 @@ pub enum Reason {
     Overrun,
     /// The friction model returned an error.
     ModelError,
+    /// The resonance search failed or tracking lost the resonance.
+    ResonanceLost,
     /// A sensor fault.
     SensorFault(SensorFault),
 }
@@ -127,6 +132,7 @@ impl Reason {
             Reason::Overcurrent => 20,
             Reason::Overrun => 21,
             Reason::ModelError => 22,
+            Reason::ResonanceLost => 23,
             Reason::SensorFault(f) => 40 + 4 * f.sensor as u16 + f.kind as u16,
         }
     }
@@ -145,6 +151,7 @@ impl Reason {
             Reason::Overcurrent => "overcurrent",
             Reason::Overrun => "overrun",
             Reason::ModelError => "model-error",
+            Reason::ResonanceLost => "resonance-lost",
             Reason::SensorFault(f) => SENSOR_FAULT_NAMES[4 * f.sensor as usize + f.kind as usize],
         }
     }
@@ -153,7 +160,11 @@ impl Reason {
     pub const fn is_fault(self) -> bool {
         matches!(
             self,
-            Reason::Overcurrent | Reason::Overrun | Reason::ModelError | Reason::SensorFault(_)
+            Reason::Overcurrent
+                | Reason::Overrun
+                | Reason::ModelError
+                | Reason::ResonanceLost
+                | Reason::SensorFault(_)
         )
     }
 
@@ -182,6 +193,7 @@ impl Reason {
             Reason::Overcurrent,
             Reason::Overrun,
             Reason::ModelError,
+            Reason::ResonanceLost,
         ]
         .into_iter()
         .chain(SENSORS.into_iter().flat_map(|sensor| {
@@ -197,6 +209,7 @@ impl From<ExternalFault> for Reason {
         match fault {
             ExternalFault::Overcurrent => Reason::Overcurrent,
             ExternalFault::Overrun => Reason::Overrun,
+            ExternalFault::ResonanceLost => Reason::ResonanceLost,
         }
     }
 }
@@ -215,7 +228,7 @@ mod tests {
     #[test]
     fn codes_and_names_are_unique_stable_words() {
         let all: Vec<Reason> = Reason::all().collect();
-        assert_eq!(all.len(), 23);
+        assert_eq!(all.len(), 24);
         for (i, a) in all.iter().enumerate() {
             assert!(is_word(a.name()) && a.name().len() <= 23, "{}", a.name());
             assert!(

@@ -50,11 +50,14 @@ pub enum ErrorCode {
     StorageFailed = 25,
     /// 26 `settings-invalid`: nothing is stored, or the stored settings fail their checks.
     SettingsInvalid = 26,
+    /// 27 `unavailable`: the command exists but this loop cannot do it (for example `freq
+    /// auto` on a scene whose stack the resonance loop cannot model); the message says why.
+    Unavailable = 27,
 }
 
 impl ErrorCode {
     /// Every code, in numeric order.
-    pub const ALL: [ErrorCode; 20] = [
+    pub const ALL: [ErrorCode; 21] = [
         ErrorCode::UnknownCommand,
         ErrorCode::BadNumber,
         ErrorCode::TrailingGarbage,
@@ -75,9 +78,10 @@ impl ErrorCode {
         ErrorCode::CalFailed,
         ErrorCode::StorageFailed,
         ErrorCode::SettingsInvalid,
+        ErrorCode::Unavailable,
     ];
 
-    /// The number on the wire, `1..=26`.
+    /// The number on the wire, `1..=27`.
     pub const fn code(self) -> u16 {
         self as u16
     }
@@ -105,6 +109,7 @@ impl ErrorCode {
             ErrorCode::CalFailed => "cal-failed",
             ErrorCode::StorageFailed => "storage-failed",
             ErrorCode::SettingsInvalid => "settings-invalid",
+            ErrorCode::Unavailable => "unavailable",
         }
     }
 
@@ -141,6 +146,7 @@ mod tests {
             (24, "cal-failed"),
             (25, "storage-failed"),
             (26, "settings-invalid"),
+            (27, "unavailable"),
         ];
         assert_eq!(ErrorCode::ALL.len(), expected.len());
         for (code, (number, name)) in ErrorCode::ALL.into_iter().zip(expected) {

@@ -183,6 +183,14 @@ pub enum ProtocolError {
         /// shown.
         reason: &'static str,
     },
+    /// The command cannot be carried out by this loop in any state (returned by the
+    /// firmware): `unavailable freq: <reason>`.
+    Unavailable {
+        /// The command's keyword.
+        command: &'static str,
+        /// Why, in plain words; at most [`MAX_REASON_LEN`] bytes are shown.
+        reason: &'static str,
+    },
 }
 
 impl ProtocolError {
@@ -209,6 +217,7 @@ impl ProtocolError {
             ProtocolError::CalFailed { .. } => ErrorCode::CalFailed,
             ProtocolError::StorageFailed { .. } => ErrorCode::StorageFailed,
             ProtocolError::SettingsInvalid { .. } => ErrorCode::SettingsInvalid,
+            ProtocolError::Unavailable { .. } => ErrorCode::Unavailable,
         }
     }
 
@@ -326,6 +335,11 @@ impl ProtocolError {
             }
             ProtocolError::SettingsInvalid { reason } => {
                 put(out, "stored settings: ")?;
+                put_sanitized(out, reason, MAX_REASON_LEN)
+            }
+            ProtocolError::Unavailable { command, reason } => {
+                put_sanitized(out, command, MAX_WORD_LEN)?;
+                put(out, " is unavailable: ")?;
                 put_sanitized(out, reason, MAX_REASON_LEN)
             }
         }

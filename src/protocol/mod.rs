@@ -103,6 +103,7 @@
 //! | 24 | `cal-failed` | the calibration could not be completed |
 //! | 25 | `storage-failed` | the settings flash could not be read or written (`save`, `load`) |
 //! | 26 | `settings-invalid` | `load`: nothing stored, or the stored settings fail a check (the reason word says which) |
+//! | 27 | `unavailable` | the command exists but this loop cannot do it (`freq auto` on a board that does not sample the drive current); the message says why |
 //!
 //! In the `save`, `load` and `defaults` replies a field at `none` is the scene's own (its
 //! datasheet calibration, its drive frequency, no target); offsets and spans are the exact
@@ -110,7 +111,7 @@
 //! full scale, `*_span_q16` the newtons of one full scale in Q16.16. `cal_count` counts the
 //! successful `tare` and `cal` commands since the defaults.
 //!
-//! Codes 1 to 13 come from this module; codes 20 to 26 are for the firmware to return when a
+//! Codes 1 to 13 come from this module; codes 20 to 27 are for the firmware to return when a
 //! well-formed command cannot be executed. A code never changes meaning; new codes get new
 //! numbers.
 //!
@@ -119,7 +120,7 @@
 //! One line per record, fields always present and always in this order:
 //!
 //! ```text
-//! tel t_us=1250000 seq=12500 state=running target=force:12.500 mu=0.312000 normal_n=40.000 tangential_n=12.480 amp=0.523000 freq_hz=40000.00 overruns=0 lost=0
+//! tel t_us=1250000 seq=12500 state=running target=force:12.500 mu=0.312000 normal_n=40.000 tangential_n=12.480 amp=0.523000 freq_hz=40000.00 overruns=0 lost=0 lock=locked phase_deg=-0.250
 //! ```
 //!
 //! | key | field | unit and format | range on the wire |
@@ -135,8 +136,10 @@
 //! | `freq_hz` | drive frequency | Hz, 2 decimals (cHz) | `0.00..=42949672.95` |
 //! | `overruns` | control-loop overruns since boot | integer | `0..=4294967295` |
 //! | `lost` | telemetry records lost since boot (UART busy) | integer | `0..=4294967295` |
+//! | `lock` | the resonance loop's state ([`Lock`]) | `pinned`, `searching`, `tracking`, `locked`, `lost`, or `none` (no loop) | |
+//! | `phase_deg` | the motional current's phase to the drive voltage (the tracker's error; 0 on resonance) | degrees, 3 decimals (mdeg), signed, or `undefined` (nothing measured) | `-2147483.648..=2147483.647` |
 //!
-//! The longest record is 227 bytes with its newline ([`TELEMETRY_CAPACITY`] is 256). A gap in
+//! The longest record is 265 bytes with its newline ([`TELEMETRY_CAPACITY`] is 288). A gap in
 //! `seq` with a matching increase of `lost` means records were dropped, not corrupted.
 
 mod code;
@@ -144,6 +147,7 @@ mod command;
 mod decode;
 mod error;
 mod line;
+mod lock;
 mod name;
 mod number;
 mod parse;
@@ -166,6 +170,7 @@ pub use command::{Axis, Command, KEYWORDS, TareAxes, format_command};
 pub use decode::{DecodeError, ErrorReply, Incoming, Payload, Reply, parse_incoming, parse_reply};
 pub use error::{MAX_QUOTED_TOKEN_LEN, MAX_REASON_LEN, ProtocolError, TokenText};
 pub use line::{LineAssembler, MAX_LINE_LEN};
+pub use lock::Lock;
 pub use name::{MAX_SCENE_NAME_LEN, RESERVED_SCENE_NAMES, SceneName, is_scene_name};
 pub use number::{
     MAX_COMMAND_DIGITS, MAX_DECODE_DIGITS, NumberError, decode_i32, decode_u32, decode_u64,

@@ -278,6 +278,10 @@ mod tests {
             ProtocolError::SettingsInvalid {
                 reason: long_reason,
             },
+            ProtocolError::Unavailable {
+                command: "freq",
+                reason: long_reason,
+            },
         ];
         assert_eq!(errors.len(), ErrorCode::ALL.len());
         let mut out = Line::new();

@@ -25,6 +25,12 @@ pub struct StatusReport {
     pub lost_telemetry: u32,
     /// The latched fault (a word), if any.
     pub latched_fault: Option<&'static str>,
+    /// The resonance loop's state (a word: `pinned`, `searching`, `tracking`, `locked`,
+    /// `lost`); `None` (`none`) without a loop.
+    pub lock: Option<&'static str>,
+    /// The motional current's phase to the voltage (the tracker's phase error), millidegrees;
+    /// `None` (`undefined`) before a window with current was measured.
+    pub phase_mdeg: Option<i32>,
 }
 
 /// The data of a `faults` reply: names (words other than `none`) of faults.
@@ -50,9 +56,10 @@ pub struct VersionReport {
 }
 
 /// Writes the `status` reply:
-/// `ok state= scene= target= mu= normal_n= tangential_n= amp= freq_hz= overruns= lost= fault=`.
+/// `ok state= scene= target= mu= normal_n= tangential_n= amp= freq_hz= overruns= lost= fault=
+/// lock= phase_deg=` (`phase_deg=undefined` when no phase was measured).
 pub fn format_status(report: &StatusReport, out: &mut StringView) -> Result<(), FormatError> {
-    OkReply::new(out)
+    let reply = OkReply::new(out)
         .word("state", report.reading.state.name())
         .word("scene", report.scene.unwrap_or(NONE))
         .target("target", report.reading.target.as_ref())
@@ -68,7 +75,12 @@ pub fn format_status(report: &StatusReport, out: &mut StringView) -> Result<(), 
         .uint("overruns", u64::from(report.overruns))
         .uint("lost", u64::from(report.lost_telemetry))
         .word("fault", report.latched_fault.unwrap_or(NONE))
-        .finish()
+        .word("lock", report.lock.unwrap_or(NONE));
+    let reply = match report.phase_mdeg {
+        Some(mdeg) => reply.fixed("phase_deg", i64::from(mdeg), 3),
+        None => reply.word("phase_deg", "undefined"),
+    };
+    reply.finish()
 }
 
 /// Writes the `faults` reply: `ok latched=a,b active=c` (`none` for an empty list).
@@ -129,6 +141,8 @@ mod tests {
             overruns: 0,
             lost_telemetry: 0,
             latched_fault: None,
+            lock: Some("locked"),
+            phase_mdeg: Some(-1_234),
         }
     }
 
@@ -139,13 +153,19 @@ mod tests {
         assert_eq!(
             out,
             "ok state=running scene=demo target=force:12.500 mu=0.312000 normal_n=40.000 \
-             tangential_n=12.480 amp=0.523000 freq_hz=40000.00 overruns=0 lost=0 fault=none\n"
+             tangential_n=12.480 amp=0.523000 freq_hz=40000.00 overruns=0 lost=0 fault=none \
+             lock=locked phase_deg=-1.234\n"
         );
         let Ok(Reply::Ok(payload)) = parse_reply(&out) else {
             panic!("{out}")
         };
         assert_eq!(payload.get("tangential_n"), Some("12.480"));
-        assert_eq!(payload.pairs().count(), 11);
+        assert_eq!(payload.pairs().count(), 13);
+        let mut undefined = status_example();
+        undefined.phase_mdeg = None;
+        undefined.lock = None;
+        format_status(&undefined, &mut out).unwrap();
+        assert!(out.ends_with("lock=none phase_deg=undefined\n"), "{out}");
     }
 
     #[test]
@@ -168,10 +188,13 @@ mod tests {
             overruns: u32::MAX,
             lost_telemetry: u32::MAX,
             latched_fault: Some(word),
+            // The longest lock word.
+            lock: Some("searching"),
+            phase_mdeg: Some(i32::MIN),
         };
         let mut out = Line::new();
         format_status(&report, &mut out).unwrap();
-        assert_eq!(out.len(), 263, "{out}");
+        assert_eq!(out.len(), 301, "{out}");
     }
 
     #[test]

@@ -7,6 +7,7 @@
 use heapless::string::StringView;
 
 use super::decode::{DecodeError, check_pairs, strip_terminator, words};
+use super::lock::Lock;
 use super::number::{NumberError, decode_i32, decode_u32, decode_u64};
 use super::reading::LoopReading;
 use super::state::SupervisorState;
@@ -16,8 +17,8 @@ use super::text::{FormatError, put, put_fixed, put_uint, write_line};
 /// First word of every telemetry line; replies start with `ok` or `err`.
 pub const TELEMETRY_TAG: &str = "tel";
 
-/// Buffer size (bytes) that holds every telemetry line; the longest possible line is 227 bytes.
-pub const TELEMETRY_CAPACITY: usize = 256;
+/// Buffer size (bytes) that holds every telemetry line; the longest possible line is 265 bytes.
+pub const TELEMETRY_CAPACITY: usize = 288;
 
 /// One telemetry sample. All fields take their full integer range on the wire.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -33,6 +34,11 @@ pub struct TelemetryRecord {
     pub overruns: u32,
     /// Records dropped since boot because the UART was still busy.
     pub lost_records: u32,
+    /// The resonance loop's state; `None` (`none`) without a loop.
+    pub lock: Option<Lock>,
+    /// The motional current's phase to the drive voltage, mdeg; `None` (`undefined`) before
+    /// anything was measured.
+    pub phase_mdeg: Option<i32>,
 }
 
 // Keys in line order; the decoder names them in its errors.
@@ -47,6 +53,10 @@ const KEY_AMP: &str = "amp";
 const KEY_FREQ: &str = "freq_hz";
 const KEY_OVERRUNS: &str = "overruns";
 const KEY_LOST: &str = "lost";
+const KEY_LOCK: &str = "lock";
+const KEY_PHASE: &str = "phase_deg";
+/// The word of an undefined phase.
+const UNDEFINED: &str = "undefined";
 
 /// Fraction digits of the scaled fields: ppm and mN and cHz.
 const PPM_DECIMALS: u8 = 6;
@@ -92,6 +102,13 @@ pub fn format_telemetry(record: &TelemetryRecord, out: &mut StringView) -> Resul
         put_uint(out, u64::from(record.overruns))?;
         key(out, KEY_LOST)?;
         put_uint(out, u64::from(record.lost_records))?;
+        key(out, KEY_LOCK)?;
+        put(out, record.lock.map_or(super::NONE, Lock::name))?;
+        key(out, KEY_PHASE)?;
+        match record.phase_mdeg {
+            Some(mdeg) => put_fixed(out, i64::from(mdeg), MN_DECIMALS)?,
+            None => put(out, UNDEFINED)?,
+        }
         put(out, "\n")
     })
 }
@@ -148,22 +165,37 @@ pub fn parse_telemetry(line: &str) -> Result<TelemetryRecord, DecodeError> {
         .unwrap_or("");
     check_pairs(body)?;
     let mut fields = Fields { words: all };
-    let record = TelemetryRecord {
-        time_us: fields.number(KEY_TIME, 0, decode_u64)?,
-        seq: fields.number(KEY_SEQ, 0, decode_u32)?,
-        reading: LoopReading {
-            state: SupervisorState::from_name(fields.next(KEY_STATE)?)
-                .ok_or(DecodeError::BadState)?,
-            target: decode_target(fields.next(KEY_TARGET)?).map_err(DecodeError::BadTarget)?,
-            friction_coef_ppm: fields.number(KEY_MU, PPM_DECIMALS, decode_u32)?,
-            normal_force_mn: fields.number(KEY_NORMAL, MN_DECIMALS, decode_i32)?,
-            tangential_force_mn: fields.number(KEY_TANGENTIAL, MN_DECIMALS, decode_i32)?,
-            drive_amplitude_ppm: fields.number(KEY_AMP, PPM_DECIMALS, decode_u32)?,
-            drive_freq_chz: fields.number(KEY_FREQ, CHZ_DECIMALS, decode_u32)?,
-        },
-        overruns: fields.number(KEY_OVERRUNS, 0, decode_u32)?,
-        lost_records: fields.number(KEY_LOST, 0, decode_u32)?,
-    };
+    let record =
+        TelemetryRecord {
+            time_us: fields.number(KEY_TIME, 0, decode_u64)?,
+            seq: fields.number(KEY_SEQ, 0, decode_u32)?,
+            reading: LoopReading {
+                state: SupervisorState::from_name(fields.next(KEY_STATE)?)
+                    .ok_or(DecodeError::BadState)?,
+                target: decode_target(fields.next(KEY_TARGET)?).map_err(DecodeError::BadTarget)?,
+                friction_coef_ppm: fields.number(KEY_MU, PPM_DECIMALS, decode_u32)?,
+                normal_force_mn: fields.number(KEY_NORMAL, MN_DECIMALS, decode_i32)?,
+                tangential_force_mn: fields.number(KEY_TANGENTIAL, MN_DECIMALS, decode_i32)?,
+                drive_amplitude_ppm: fields.number(KEY_AMP, PPM_DECIMALS, decode_u32)?,
+                drive_freq_chz: fields.number(KEY_FREQ, CHZ_DECIMALS, decode_u32)?,
+            },
+            overruns: fields.number(KEY_OVERRUNS, 0, decode_u32)?,
+            lost_records: fields.number(KEY_LOST, 0, decode_u32)?,
+            lock: match fields.next(KEY_LOCK)? {
+                word if word == super::NONE => None,
+                // An unknown lock word is a bad state word, like `state=`'s.
+                word => Some(Lock::from_name(word).ok_or(DecodeError::BadState)?),
+            },
+            phase_mdeg: match fields.next(KEY_PHASE)? {
+                UNDEFINED => None,
+                value => Some(decode_i32(value, MN_DECIMALS).map_err(|error| {
+                    DecodeError::BadNumber {
+                        key: KEY_PHASE,
+                        error,
+                    }
+                })?),
+            },
+        };
     match fields.words.next() {
         Some(_) => Err(DecodeError::ExtraField),
         None => Ok(record),
@@ -182,7 +214,7 @@ mod tests {
 
     const EXAMPLE: &str = "tel t_us=1250000 seq=12500 state=running target=force:12.500 \
         mu=0.312000 normal_n=40.000 tangential_n=-12.480 amp=0.523000 freq_hz=40000.00 \
-        overruns=0 lost=3\n";
+        overruns=0 lost=3 lock=locked phase_deg=-0.250\n";
 
     fn example() -> TelemetryRecord {
         TelemetryRecord {
@@ -199,6 +231,8 @@ mod tests {
             },
             overruns: 0,
             lost_records: 3,
+            lock: Some(Lock::Locked),
+            phase_mdeg: Some(-250),
         }
     }
 
@@ -233,9 +267,11 @@ mod tests {
             },
             overruns: u32::MAX,
             lost_records: u32::MAX,
+            lock: Some(Lock::Searching),
+            phase_mdeg: Some(i32::MIN),
         };
         let text = line(&record);
-        assert_eq!(text.len(), 227, "{text}");
+        assert_eq!(text.len(), 265, "{text}");
         assert_eq!(parse_telemetry(&text), Ok(record));
     }
 
@@ -249,17 +285,35 @@ mod tests {
             Err(DecodeError::UnexpectedField { key: "seq" })
         );
         assert_eq!(
-            parse_telemetry(&replace(" lost=3", "")),
-            Err(DecodeError::MissingField { key: "lost" })
+            parse_telemetry(&replace(" phase_deg=-0.250", "")),
+            Err(DecodeError::MissingField { key: "phase_deg" })
         );
         assert_eq!(
-            parse_telemetry(&replace("lost=3", "lost=3 extra=1")),
+            parse_telemetry(&replace("phase_deg=-0.250", "phase_deg=-0.250 extra=1")),
             Err(DecodeError::ExtraField)
         );
         assert_eq!(
-            parse_telemetry(&replace("lost=3", "lost=3 extra")),
-            Err(DecodeError::BadPair { index: 11 })
+            parse_telemetry(&replace("phase_deg=-0.250", "phase_deg=-0.250 extra")),
+            Err(DecodeError::BadPair { index: 13 })
         );
+        assert_eq!(
+            parse_telemetry(&replace("lock=locked", "lock=wobbly")),
+            Err(DecodeError::BadState)
+        );
+        assert_eq!(
+            parse_telemetry(&replace("phase_deg=-0.250", "phase_deg=undefined")),
+            Ok(TelemetryRecord {
+                phase_mdeg: None,
+                ..example()
+            })
+        );
+        assert!(matches!(
+            parse_telemetry(&replace("phase_deg=-0.250", "phase_deg=-0.2501")),
+            Err(DecodeError::BadNumber {
+                key: "phase_deg",
+                ..
+            })
+        ));
         assert_eq!(
             parse_telemetry(&replace("state=running", "state=dancing")),
             Err(DecodeError::BadState)
@@ -306,6 +360,10 @@ mod tests {
             any_target(),
             (any::<u32>(), any::<i32>(), any::<i32>()),
             (any::<u32>(), any::<u32>(), any::<u32>(), any::<u32>()),
+            (
+                proptest::option::of(proptest::sample::select(&Lock::ALL[..])),
+                proptest::option::of(any::<i32>()),
+            ),
         )
             .prop_map(
                 |(
@@ -313,6 +371,7 @@ mod tests {
                     target,
                     (mu, normal, tangential),
                     (amp, freq, overruns, lost),
+                    (lock, phase_mdeg),
                 )| {
                     TelemetryRecord {
                         time_us,
@@ -328,6 +387,8 @@ mod tests {
                         },
                         overruns,
                         lost_records: lost,
+                        lock,
+                        phase_mdeg,
                     }
                 },
             )

@@ -93,12 +93,42 @@ pub struct LockIn {
     sum_x: i64,
     sum_cos: i64,
     sum_sin: i64,
+    /// PWM-synchronous sampling ([`Self::synchronous`]): the reference's advance per sample
+    /// is this, whatever the drive frequency.
+    fixed_step: Option<u32>,
 }
 
 impl LockIn {
+    /// A demodulator for samples taken synchronously to the drive's PWM: one per PWM period,
+    /// the trigger's phase within the period advancing by `phase_step` turns x 2^32 from one
+    /// period to the next (the G474 plan: TIM1's CCR4 stepped through `0, 1/4, 1/2, 3/4` of
+    /// the period, `phase_step = 2^30`). The drive phase then advances by exactly
+    /// `phase_step` per sample at any drive frequency, so a window of `periods_per_window`
+    /// turns of it is `periods_per_window 2^32 / phase_step` samples (4 at a quarter turn:
+    /// four PWM periods, 100 us at 40 kHz). `config.sample_rate_hz` is then the nominal
+    /// rate (one sample per period at the stack's nominal f0): the search and the tracker
+    /// use it for their time constants, which are off by the ratio of the drive to the
+    /// nominal frequency (at most 10 % over +-10 %). Errors: see [`Self::retune`]
+    /// (`SamplingTooSlow` for a step of more than a third of a turn either way).
+    pub fn synchronous(
+        config: LockInConfig,
+        drive: Frequency,
+        phase_step: u32,
+    ) -> Result<Self, ResonanceError> {
+        Self::build(config, drive, Some(phase_step))
+    }
+
     /// A demodulator for a drive at `drive` (the frequency the timer really produces), with
     /// the drive phase 0 at the first sample. Errors: see [`Self::retune`].
     pub fn new(config: LockInConfig, drive: Frequency) -> Result<Self, ResonanceError> {
+        Self::build(config, drive, None)
+    }
+
+    fn build(
+        config: LockInConfig,
+        drive: Frequency,
+        fixed_step: Option<u32>,
+    ) -> Result<Self, ResonanceError> {
         let mut lock_in = Self {
             config,
             step: 0,
@@ -114,6 +144,7 @@ impl LockIn {
             sum_x: 0,
             sum_cos: 0,
             sum_sin: 0,
+            fixed_step,
         };
         lock_in.retune(drive)?;
         Ok(lock_in)
@@ -126,13 +157,24 @@ impl LockIn {
     /// Errors: `SamplingTooSlow` for fewer than 3 samples per turn of the aliased drive phase,
     /// `WindowLength` for zero periods or a window above [`MAX_WINDOW_SAMPLES`].
     pub fn retune(&mut self, drive: Frequency) -> Result<(), ResonanceError> {
+        // Synchronous sampling without a sense delay: nothing depends on the frequency once
+        // the window is set up (`inv_window_q62 != 0`), so a retune only starts a new window.
+        if self.fixed_step.is_some() && self.config.sense_delay_ns == 0 && self.inv_window_q62 != 0
+        {
+            self.clear();
+            return Ok(());
+        }
         let rate = u128::from(self.config.sample_rate_hz) * 1000;
         if rate == 0 {
             return Err(ResonanceError::SamplingTooSlow);
         }
         let millihertz = u128::from(drive.millihertz());
-        // Turns per sample x 2^32, rounded, reduced to the aliased rotation.
-        let step = (((millihertz << 32) + rate / 2) / rate) as u32;
+        // Turns per sample x 2^32, rounded, reduced to the aliased rotation (or the fixed
+        // advance of PWM-synchronous sampling).
+        let step = match self.fixed_step {
+            Some(step) => step,
+            None => (((millihertz << 32) + rate / 2) / rate) as u32,
+        };
         let rotation = u64::from((step as i32).unsigned_abs());
         if rotation == 0 || rotation * 3 > 1 << 32 {
             return Err(ResonanceError::SamplingTooSlow);

@@ -60,6 +60,7 @@
 //! command that measures them: `docs/resonance.md`.
 
 mod error;
+mod follow;
 mod lockin;
 mod motional;
 mod phasor;
@@ -72,6 +73,10 @@ mod tracker;
 mod tuning;
 
 pub use error::{ResonanceError, ResonanceFault};
+pub use follow::{
+    LOST_WINDOWS, LockState, ResonanceLoop, ResonanceReport, ResonanceSettings,
+    SYNCHRONOUS_FIRST_PHASE, SYNCHRONOUS_PHASE_STEP, current_sample,
+};
 pub use lockin::{Demodulated, LockIn, LockInConfig, MAX_WINDOW_SAMPLES};
 pub use motional::{ClampedCapacitance, MAX_DETUNING, detuning};
 pub use phasor::{Angle, Phasor, Polar};

@@ -157,6 +157,19 @@ impl Phasor {
         }
     }
 
+    /// Whether the amplitude is below `threshold` (a non-negative Q2.30), exactly, without the
+    /// CORDIC: `re^2 + im^2 < t^2` in `u64` (each square <= 2^62, the sum <= 2^63). A
+    /// negative threshold is never reached. For the per-window no-current check.
+    pub const fn is_below(self, threshold: Q2_30) -> bool {
+        if threshold.to_bits() < 0 {
+            return false;
+        }
+        let x = self.in_phase.to_bits().unsigned_abs() as u64;
+        let y = self.quadrature.to_bits().unsigned_abs() as u64;
+        let t = threshold.to_bits() as u64;
+        x * x + y * y < t * t
+    }
+
     /// Amplitude and phase by CORDIC vectoring: the vector is rotated onto the positive
     /// in-phase axis by 31 shift-and-add micro-rotations while the rotation angles are summed.
     /// Amplitude error <= 2 ulp of Q2.30; phase error <= 2 binary-angle units (3e-9 rad)
@@ -308,6 +321,15 @@ mod tests {
             assert!(phase_error(polar.phase, want) < 1e-8, "{p:?}");
         }
         assert_eq!(Phasor::ZERO.polar(), Polar::default());
+        // The exact no-current test, at the extremes of both formats.
+        let corner = Phasor::new(Q2_30::MIN, Q2_30::MIN);
+        assert!(!corner.is_below(Q2_30::MAX));
+        assert!(Phasor::ZERO.is_below(Q2_30::from_bits(1)));
+        assert!(!Phasor::ZERO.is_below(Q2_30::ZERO));
+        assert!(!Phasor::ZERO.is_below(Q2_30::from_bits(-1)));
+        let three_four = Phasor::new(Q2_30::from_bits(3 << 20), Q2_30::from_bits(-4 << 20));
+        assert!(!three_four.is_below(Q2_30::from_bits(5 << 20)));
+        assert!(three_four.is_below(Q2_30::from_bits((5 << 20) + 1)));
         // The largest components: magnitude 2 sqrt(2) does not fit Q2.30 and is flagged.
         let corner = Phasor::new(Q2_30::MIN, Q2_30::MIN).polar();
         assert!(corner.saturated);

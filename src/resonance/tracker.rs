@@ -25,7 +25,7 @@
 use super::error::{ResonanceError, ResonanceFault};
 use super::lockin::Demodulated;
 use super::motional::{MAX_DETUNING, detuning};
-use super::phasor::Polar;
+use super::phasor::Phasor;
 use super::stack::StackModel;
 use super::tuning::Tuning;
 use crate::drive::{Amplitude, Frequency, TimerClock};
@@ -176,8 +176,9 @@ pub struct TrackStatus {
     pub tuning: Tuning,
     /// The measured detuning, half-bandwidths (Q8.24): `(f - f0) / (f0 / 2Q)`.
     pub detuning: Q8_24,
-    /// The motional current, full scale, and its phase to the voltage.
-    pub motional: Polar,
+    /// The motional current, full scale, relative to the voltage (its `polar()` phase is the
+    /// phase error; not computed here: a CORDIC the loop itself does not need).
+    pub motional: Phasor,
     /// On resonance for the configured number of windows.
     pub locked: bool,
     /// The step was clipped by the rate bound.
@@ -250,7 +251,7 @@ impl Tracker {
         let mut status = TrackStatus {
             tuning: self.tuning,
             detuning: Q8_24::ZERO,
-            motional: Polar::default(),
+            motional: Phasor::ZERO,
             locked: false,
             rate_limited: false,
         };
@@ -259,7 +260,7 @@ impl Tracker {
             self.in_lock = 0;
             return Ok(status);
         }
-        if window.phasor.polar().amplitude < stack.min_current(amplitude) {
+        if window.phasor.is_below(stack.min_current(amplitude)) {
             self.without_current = self.without_current.saturating_add(1);
             self.previous_error_mhz = 0;
             self.in_lock = 0;
@@ -319,7 +320,7 @@ impl Tracker {
         self.previous_error_mhz = error;
         status.tuning = self.tuning;
         status.detuning = x;
-        status.motional = motional.polar();
+        status.motional = motional;
         status.locked = self.in_lock >= config.lock_windows;
         status.rate_limited = step != wanted;
         Ok(status)

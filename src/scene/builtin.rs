@@ -7,8 +7,8 @@
 #[allow(unused_imports)]
 use super::{
     Accuracy, Actuator, ActuatorKind, Breakpoint, Channel, Contents, Criterion, FaultEvent,
-    FaultKind, Horn, LoadCell, Mismatch, ModelKind, ModelSpec, Rail, RoughSurface, Scene, Stack,
-    System, TargetPoint, Transducer,
+    FaultKind, Horn, LoadCell, Mismatch, ModelKind, ModelSpec, Rail, ResonanceShift, RoughSurface,
+    Scene, Stack, System, TargetPoint, Transducer,
 };
 #[allow(unused_imports)]
 use crate::protocol::Target;

@@ -82,6 +82,48 @@ pub struct Transducer {
     pub clamped_capacitance_f: f64,
     /// Motional resistance R1, ohm, (0, 1e5].
     pub motional_resistance_ohm: f64,
+    /// Self-heating, load shift, envelope form and `freq auto` (`[transducer.shift]`).
+    pub shift: ResonanceShift,
+}
+
+/// How the transducer's resonance moves beyond the linear drift (the plant), and whether the
+/// scene runs the resonance loop (`freq auto`). [`ResonanceShift::NONE`] (every field zero or
+/// false) is the plant of the scenes that predate it, bit for bit.
+///
+/// `f0(t) = (resonance_hz + drift t) (1 + thermal_per_k dT + load_per_n (F_n - F_n(0)))`,
+/// `tau_th d(dT)/dt = R_th P - dT` with `P = |I_m|^2 R1 / 2` dissipated in the motional branch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ResonanceShift {
+    /// Relative f0 change per kelvin of self-heating, 1/K, |.| <= 1e-2 (PMN-PT stacks soften:
+    /// negative).
+    pub thermal_per_k: f64,
+    /// Thermal resistance from the stack to ambient, K/W, [0, 1e3].
+    pub thermal_resistance_k_per_w: f64,
+    /// Thermal time constant, s, (0, 1e4].
+    pub thermal_time_constant_s: f64,
+    /// Relative f0 change per newton of static normal load above the initial load, 1/N,
+    /// |.| <= 1e-2 (clamping stiffens the stack: positive).
+    pub load_per_n: f64,
+    /// The motional branch as a complex envelope (`tau dA/dt = u - (1 + j x) A`, the series
+    /// R1-L1-C1 branch's own dynamics: its phase lags a frequency change like a real stack's)
+    /// instead of the real envelope with the settled phase; the plant then also samples the
+    /// drive current synchronously to the PWM for the resonance loop.
+    pub bvd_envelope: bool,
+    /// The scene runs `freq auto` before its start: the loop searches, then tracks.
+    pub freq_auto: bool,
+}
+
+impl ResonanceShift {
+    /// No shift, real envelope, frequency pinned.
+    pub const NONE: Self = Self {
+        thermal_per_k: 0.0,
+        thermal_resistance_k_per_w: 0.0,
+        thermal_time_constant_s: 1.0,
+        load_per_n: 0.0,
+        bvd_envelope: false,
+        freq_auto: false,
+    };
 }
 
 impl Transducer {

@@ -29,7 +29,7 @@ mod table;
 pub use builtin::{SCENES, find};
 pub use criteria::{Accuracy, Contents, Criterion};
 pub use fault::{Channel, FaultEvent, FaultKind, Rail};
-pub use hardware::{Actuator, ActuatorKind, Horn, LoadCell, Stack, Transducer};
+pub use hardware::{Actuator, ActuatorKind, Horn, LoadCell, ResonanceShift, Stack, Transducer};
 pub use spec::{Mismatch, ModelKind, ModelSpec, RoughSurface};
 pub use table::{Breakpoint, TargetPoint, interpolate, target_at};
 

@@ -318,16 +318,19 @@ impl ControlLoop for BoardRig {
                 .controller_mut()
                 .trip(ExternalFault::Overcurrent);
         }
-        Some(Snapshot::new(
-            &control.output,
-            setup.station.controller().target(),
-            setup.scene.name,
-            setup.station.drive_freq_chz(),
-            control
-                .sensor_fault
-                .map(|fault| Reason::SensorFault(fault).name()),
-            cycles,
-        ))
+        Some(
+            Snapshot::new(
+                &control.output,
+                setup.station.controller().target(),
+                setup.scene.name,
+                setup.station.drive_freq_chz(),
+                control
+                    .sensor_fault
+                    .map(|fault| Reason::SensorFault(fault).name()),
+                cycles,
+            )
+            .with_resonance(setup.station.resonance()),
+        )
     }
 
     fn execute(&mut self, command: &Command) -> Result<(), ProtocolError> {

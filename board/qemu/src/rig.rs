@@ -185,16 +185,19 @@ impl ControlLoop for SimulatedRig {
         drive::set(output.amplitude);
         let cycles = time_driver::cycles().saturating_sub(start);
         let record = time_driver::exclude(|| self.run.finish_step())?;
-        Some(Snapshot::new(
-            &output,
-            self.run.controller().target(),
-            self.scene.name,
-            self.run.station().drive_freq_chz(),
-            record
-                .sensor_fault
-                .map(|fault| sonolube::control::Reason::SensorFault(fault).name()),
-            u32::try_from(cycles).unwrap_or(u32::MAX),
-        ))
+        Some(
+            Snapshot::new(
+                &output,
+                self.run.controller().target(),
+                self.scene.name,
+                self.run.station().drive_freq_chz(),
+                record
+                    .sensor_fault
+                    .map(|fault| sonolube::control::Reason::SensorFault(fault).name()),
+                u32::try_from(cycles).unwrap_or(u32::MAX),
+            )
+            .with_resonance(self.run.station().resonance()),
+        )
     }
 
     fn execute(&mut self, command: &Command) -> Result<(), ProtocolError> {

@@ -3,6 +3,7 @@
 //! ```text
 //! sonolube speed --qemu LOG [--root DIR]
 //! sonolube speed --check [--qemu LOG] [--root DIR]
+//! sonolube speed --qemu LOG --keep-host-ratios [--root DIR]
 //! ```
 //!
 //! Reads the instruction counts from `LOG` (the decoded output of the QEMU benchmark build;
@@ -10,6 +11,10 @@
 //! only: a debug build's timings mean nothing), and writes `docs/speed.md`, `docs/speed.svg`
 //! and `src/variant/table.rs` under `DIR` (default: the repository). `scripts/speed-table`
 //! builds and runs the benchmark firmware and calls this with its log.
+//!
+//! `--keep-host-ratios` writes the files without timing the host: the host ratios are the
+//! committed `docs/speed.md`'s (any build). For a change that adds a scene: its errors are
+//! measured and every committed count and ratio stays.
 //!
 //! `--check` writes nothing and times nothing: it regenerates the files from the committed
 //! counts (`docs/speed-qemu.txt` unless `--qemu` is given) and the host ratios recorded in the
@@ -24,7 +29,7 @@ use std::process::ExitCode;
 
 use crate::speed::{self, MARKDOWN, QEMU_LOG, markdown, timing};
 
-const USAGE: &str = "usage: sonolube speed --qemu LOG [--root DIR]\n       sonolube speed --check [--qemu LOG] [--root DIR]\n";
+const USAGE: &str = "usage: sonolube speed --qemu LOG [--keep-host-ratios] [--root DIR]\n       sonolube speed --check [--qemu LOG] [--root DIR]\n";
 
 fn usage(message: &str) -> ExitCode {
     eprint!("sonolube speed: {message}\n{USAGE}");
@@ -46,6 +51,7 @@ fn read(path: &str) -> Result<String, String> {
 /// Entry point: `args` are the arguments after `speed`.
 pub fn run(args: &[String]) -> ExitCode {
     let (mut log, mut root, mut check) = (None, speed::repo_root(), false);
+    let mut keep_ratios = false;
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
         match arg.as_str() {
@@ -58,6 +64,7 @@ pub fn run(args: &[String]) -> ExitCode {
                 None => return usage("--root needs a directory"),
             },
             "--check" => check = true,
+            "--keep-host-ratios" => keep_ratios = true,
             other => return usage(&format!("unknown argument {other:?}")),
         }
     }
@@ -66,7 +73,7 @@ pub fn run(args: &[String]) -> ExitCode {
         run_check(&log, &root)
     } else {
         match log {
-            Some(log) => run_write(&log, &root),
+            Some(log) => run_write(&log, &root, keep_ratios),
             None => return usage("--qemu LOG is required (or --check)"),
         }
     };
@@ -79,16 +86,22 @@ pub fn run(args: &[String]) -> ExitCode {
     }
 }
 
-fn run_write(log: &str, root: &std::path::Path) -> Result<ExitCode, String> {
-    if cfg!(debug_assertions) {
+fn run_write(log: &str, root: &std::path::Path, keep_ratios: bool) -> Result<ExitCode, String> {
+    if cfg!(debug_assertions) && !keep_ratios {
         return Err("host timings need a release build: cargo run --release ... -- speed".into());
     }
     let log_text = read(log)?;
     speed::qemu::parse(&log_text)?; // fail before the long part
-    let ratios: BTreeMap<String, f64> = timing::measure()?
-        .into_iter()
-        .map(|(name, r)| (name.to_string(), r))
-        .collect();
+    let ratios: BTreeMap<String, f64> = if keep_ratios {
+        let committed = std::fs::read_to_string(root.join(MARKDOWN))
+            .map_err(|e| format!("{}: {e}", root.join(MARKDOWN).display()))?;
+        markdown::host_ratios(&committed)
+    } else {
+        timing::measure()?
+            .into_iter()
+            .map(|(name, r)| (name.to_string(), r))
+            .collect()
+    };
     let outputs = speed::generate(&log_text, &ratios)?;
     for (path, contents) in outputs.files() {
         let full = root.join(path);

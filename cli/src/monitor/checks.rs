@@ -122,7 +122,7 @@ impl<'a> Run<'a> {
             format!(" (undocumented keys: {})", status.extra_keys.join(","))
         };
         Ok(format!(
-            "firmware={} board={} protocol={}; status has all 11 fields: state={} scene={} \
+            "firmware={} board={} protocol={}; status has all 13 fields: state={} scene={} \
              target={} mu={} amp={} overruns={} fault={}{extra}",
             version.firmware,
             version.board,

@@ -22,7 +22,7 @@ use super::reports::{fixed, target_text};
 
 /// The header row (without its newline).
 pub const CSV_HEADER: &str =
-    "t_us,seq,state,target,mu,normal_n,tangential_n,amp,freq_hz,overruns,lost";
+    "t_us,seq,state,target,mu,normal_n,tangential_n,amp,freq_hz,overruns,lost,lock,phase_deg";
 
 /// The CSV text of `records`.
 pub fn telemetry_csv(records: &[TelemetryRecord]) -> String {
@@ -32,7 +32,7 @@ pub fn telemetry_csv(records: &[TelemetryRecord]) -> String {
     for r in records {
         let _ = writeln!(
             text,
-            "{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.time_us,
             r.seq,
             r.reading.state.name(),
@@ -44,6 +44,9 @@ pub fn telemetry_csv(records: &[TelemetryRecord]) -> String {
             fixed(i64::from(r.reading.drive_freq_chz), 2),
             r.overruns,
             r.lost_records,
+            r.lock.map_or("none", |lock| lock.name()),
+            r.phase_mdeg
+                .map_or_else(|| "undefined".to_string(), |m| fixed(i64::from(m), 3)),
         );
     }
     text
@@ -71,6 +74,8 @@ mod tests {
             },
             overruns: 0,
             lost_records: 3,
+            lock: None,
+            phase_mdeg: None,
         };
         let text = telemetry_csv(&[record, record]);
         let lines: Vec<&str> = text.lines().collect();

@@ -33,6 +33,10 @@ pub struct Status {
     pub lost: u32,
     /// Latched fault, `None` for `none`.
     pub fault: Option<String>,
+    /// The resonance loop's state, `None` for `none` (no loop).
+    pub lock: Option<String>,
+    /// The motional current's phase to the voltage, mdeg; `None` for `undefined`.
+    pub phase_mdeg: Option<i32>,
     /// Keys the reply carried that this protocol version does not document.
     pub extra_keys: Vec<String>,
 }
@@ -49,7 +53,7 @@ pub struct Version {
 }
 
 /// The keys of a `status` reply, in order.
-pub const STATUS_KEYS: [&str; 11] = [
+pub const STATUS_KEYS: [&str; 13] = [
     "state",
     "scene",
     "target",
@@ -61,6 +65,8 @@ pub const STATUS_KEYS: [&str; 11] = [
     "overruns",
     "lost",
     "fault",
+    "lock",
+    "phase_deg",
 ];
 
 /// The payload of an `ok` reply, or what the reply was instead.
@@ -112,6 +118,11 @@ pub fn decode_status(reply: &ReplyLine) -> Result<Status, String> {
         overruns: number(&payload, "overruns", 0, decode_u32)?,
         lost: number(&payload, "lost", 0, decode_u32)?,
         fault: optional_word(field(&payload, "fault")?),
+        lock: optional_word(field(&payload, "lock")?),
+        phase_mdeg: match field(&payload, "phase_deg")? {
+            "undefined" => None,
+            _ => Some(number(&payload, "phase_deg", 3, decode_i32)?),
+        },
         extra_keys: payload
             .pairs()
             .map(|(key, _)| key)
@@ -173,7 +184,8 @@ mod tests {
     fn status_fields_decode() {
         let status = decode_status(&reply(
             "ok state=running scene=demo target=coef:0.150000 mu=0.151000 normal_n=40.000 \
-             tangential_n=-6.040 amp=0.523000 freq_hz=40000.00 overruns=0 lost=3 fault=none",
+             tangential_n=-6.040 amp=0.523000 freq_hz=40000.00 overruns=0 lost=3 fault=none \
+             lock=locked phase_deg=-0.250",
         ))
         .unwrap();
         assert_eq!(status.state, SupervisorState::Running);
@@ -185,13 +197,16 @@ mod tests {
         assert_eq!(status.drive_freq_chz, 4_000_000);
         assert_eq!((status.overruns, status.lost), (0, 3));
         assert_eq!(status.fault, None);
+        assert_eq!(status.lock.as_deref(), Some("locked"));
+        assert_eq!(status.phase_mdeg, Some(-250));
         assert!(status.extra_keys.is_empty());
     }
 
     #[test]
     fn missing_or_bad_fields_are_named() {
         let full = "ok state=idle scene=none target=none mu=0.240000 normal_n=40.000 \
-                    tangential_n=9.600 amp=0.000000 freq_hz=40000.00 overruns=0 lost=0 fault=none";
+                    tangential_n=9.600 amp=0.000000 freq_hz=40000.00 overruns=0 lost=0 fault=none \
+                    lock=pinned phase_deg=undefined";
         assert!(decode_status(&reply(full)).is_ok());
         for key in STATUS_KEYS {
             let without: Vec<&str> = full

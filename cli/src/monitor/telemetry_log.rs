@@ -139,6 +139,8 @@ mod tests {
             },
             overruns: 0,
             lost_records: lost,
+            lock: None,
+            phase_mdeg: None,
         }
     }
 

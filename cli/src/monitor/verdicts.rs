@@ -206,6 +206,8 @@ mod tests {
             },
             overruns: 0,
             lost_records: 0,
+            lock: None,
+            phase_mdeg: None,
         }
     }
 

@@ -97,6 +97,11 @@ pub struct SensorReadings {
     pub sliding_velocity_m_per_s: f32,
     /// Drive current at the drive frequency (for the resonance tracker).
     pub drive_current: CurrentPhasor,
+    /// The current sense's 12-bit codes over the period, one per PWM period (transducers
+    /// with `bvd_envelope` only; the first `current_count` are valid).
+    pub current_codes: [u16; transducer::MAX_CURRENT_CODES],
+    /// Valid entries of `current_codes`.
+    pub current_count: u8,
     /// Ground truth.
     pub truth: GroundTruth,
 }
@@ -115,6 +120,7 @@ pub struct Plant<'a, M> {
     full_scale_amplitude_m: f32,
     step: u32,
     last_contact: ContactTruth,
+    initial_load_n: f32,
 }
 
 impl<'a> Plant<'a, AnyModel> {
@@ -152,7 +158,12 @@ impl<'a, M: FrictionModel> Plant<'a, M> {
         let substep_s = (1.0 / (scene.control_rate_hz * f64::from(scene.plant_substeps))) as f32;
         Ok(Self {
             scenario,
-            transducer: ResonantTransducer::new(&scene.transducer, &scene.actuator),
+            transducer: ResonantTransducer::with_shift(
+                &scene.transducer,
+                &scene.actuator,
+                scene.noise_seed,
+            ),
+            initial_load_n: start.normal_load_n,
             normal_cell: LoadCellSim::new(&scene.normal_cell, substep_s, start.normal_load_n),
             tangential_cell: LoadCellSim::new(
                 &scene.tangential_cell,
@@ -202,6 +213,8 @@ impl<'a, M: FrictionModel> Plant<'a, M> {
         let mut inputs = self.scenario.at(start_s as f32);
         for k in 1..=self.substeps {
             self.transducer
+                .set_load(inputs.normal_load_n, self.initial_load_n);
+            self.transducer
                 .advance(drive_command, drive_hz, substep_s as f32);
             inputs = self
                 .scenario
@@ -225,12 +238,15 @@ impl<'a, M: FrictionModel> Plant<'a, M> {
             .sample(&mut self.noise, tangential_fault);
         let time_s = now as f32;
         let amplitude = self.transducer.envelope();
+        let (current_codes, current_count) = self.transducer.take_current_codes();
         SensorReadings {
             step: self.step,
             normal_code,
             tangential_code,
             sliding_velocity_m_per_s: inputs.sliding_velocity_m_per_s,
             drive_current: self.transducer.current(),
+            current_codes,
+            current_count: current_count as u8,
             truth: GroundTruth {
                 time_s,
                 normal_load_n: inputs.normal_load_n,

@@ -12,6 +12,7 @@ const STACK: Transducer = Transducer {
     drive_hz: 40_000.0,
     clamped_capacitance_f: 300e-9,
     motional_resistance_ohm: 3.1,
+    shift: sonolube::scene::ResonanceShift::NONE,
 };
 
 const ACTUATOR: Actuator = Actuator {
