@@ -7,7 +7,13 @@
 //! ```text
 //! sonolube scene NAME [--out DIR] [--file PATH.toml]
 //! sonolube scene --all [--out DIR]
+//! sonolube scene NAME|--all --seeds N|A-B [--plot PATH.svg]
+//! sonolube scene NAME --mismatch|--envelope|--noise [--seeds N|A-B] [--out DIR]
 //! ```
+//!
+//! `--seeds`, `--mismatch`, `--envelope` and `--noise` are the robustness sweeps ([`robust`]):
+//! many runs over every core, a table per criterion (pass rate, percentiles, worst run), a
+//! closing one-line summary, exit 0 only when every run passes.
 //!
 //! `NAME` is a built-in scene (`scenes/*.toml`, compiled in); `--file` runs any scene file
 //! (its `name` must match `NAME` when both are given). Files go to `DIR` (default
@@ -39,7 +45,11 @@
 
 mod csv;
 mod figure;
+mod grid;
 mod report;
+pub mod robust;
+mod spread;
+mod sweep;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -55,7 +65,9 @@ pub use csv::csv;
 pub use report::{model_line, model_name};
 
 const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml]\n       \
-                     sonolube scene --all [--out DIR]\n";
+                     sonolube scene --all [--out DIR]\n       \
+                     sonolube scene NAME|--all --seeds N|A-B [--plot PATH.svg]\n       \
+                     sonolube scene NAME --mismatch|--envelope|--noise [--seeds N|A-B] [--out DIR]\n";
 
 /// Entry point: `args` are the arguments after `scene`.
 pub fn run(args: &[String]) -> ExitCode {
@@ -63,18 +75,35 @@ pub fn run(args: &[String]) -> ExitCode {
     let mut out = PathBuf::from("target/scenes");
     let mut file = None;
     let mut all = false;
+    let mut seeds = None;
+    let mut plot = None;
+    let mut sweep = None;
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
         match arg.as_str() {
             "--all" => all = true,
-            "--out" | "--file" => {
+            "--mismatch" | "--envelope" | "--noise" => {
+                if sweep.is_some() {
+                    return usage("one of --mismatch, --envelope, --noise at a time");
+                }
+                sweep = Some(match arg.as_str() {
+                    "--mismatch" => robust::Sweep::Mismatch,
+                    "--envelope" => robust::Sweep::Envelope,
+                    _ => robust::Sweep::Noise,
+                });
+            }
+            "--out" | "--file" | "--seeds" | "--plot" => {
                 let Some(value) = rest.next() else {
                     return usage(&format!("{arg} needs a value"));
                 };
-                if arg == "--out" {
-                    out = PathBuf::from(value);
-                } else {
-                    file = Some(PathBuf::from(value));
+                match arg.as_str() {
+                    "--out" => out = PathBuf::from(value),
+                    "--file" => file = Some(PathBuf::from(value)),
+                    "--plot" => plot = Some(PathBuf::from(value)),
+                    _ => match robust::parse_seeds(value) {
+                        Ok(list) => seeds = Some(list),
+                        Err(problem) => return usage(&problem),
+                    },
                 }
             }
             "-h" | "--help" => {
@@ -86,9 +115,26 @@ pub fn run(args: &[String]) -> ExitCode {
             _ => return usage(&format!("unexpected argument {arg}")),
         }
     }
+    let robust = seeds.is_some() || sweep.is_some();
+    if plot.is_some() && !robust {
+        return usage("--plot goes with --seeds, --mismatch, --envelope or --noise");
+    }
     if all {
         if name.is_some() || file.is_some() {
             return usage("--all takes no scene name and no --file");
+        }
+        if sweep.is_some() {
+            return usage("--mismatch, --envelope and --noise take one scene NAME, not --all");
+        }
+        if let Some(seeds) = &seeds {
+            let scenes = robust::builtin();
+            return robust::run(
+                &scenes,
+                robust::Sweep::Seeds,
+                Some(seeds),
+                plot.as_deref(),
+                &out,
+            );
         }
         return run_all(&out);
     }
@@ -111,6 +157,15 @@ pub fn run(args: &[String]) -> ExitCode {
         },
         (None, None) => return usage("a scene NAME, --file or --all is needed"),
     };
+    if robust {
+        return robust::run(
+            &[scene],
+            sweep.unwrap_or(robust::Sweep::Seeds),
+            seeds.as_deref(),
+            plot.as_deref(),
+            &out,
+        );
+    }
     match run_one(&scene, &out) {
         Ok(run) => {
             print!("{}", run.report);
