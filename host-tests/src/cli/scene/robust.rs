@@ -301,7 +301,7 @@ fn envelope(scene: &Scene<'_>, seeds: &[u64], jobs: usize, out: &Path) -> Result
         }
         println!();
     }
-    for line in failures(&runs, &results).iter().take(20) {
+    for line in failures(&runs, &results) {
         println!("  FAIL {line}");
     }
     Ok(Done { stats, results })
