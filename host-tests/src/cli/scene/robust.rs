@@ -309,7 +309,7 @@ fn envelope(scene: &Scene<'_>, seeds: &[u64], jobs: usize, out: &Path) -> Result
 
 /// The built-in scenes.
 pub fn builtin() -> Vec<Scene<'static>> {
-    SCENES.iter().copied().collect()
+    SCENES.to_vec()
 }
 
 #[cfg(test)]
