@@ -162,12 +162,8 @@ fn sweep_runs(scene: &Scene<'_>, runs: &[Run<'_>], jobs: usize) -> Result<Done, 
     let results = run_all(runs, jobs, scene.name);
     let stats = criterion_stats(scene, runs, &results);
     print!("{}", stats_table(&stats));
-    let failed = failures(runs, &results);
-    for line in failed.iter().take(10) {
+    for line in failures(runs, &results) {
         println!("  FAIL {line}");
-    }
-    if failed.len() > 10 {
-        println!("  ... and {} more failed runs", failed.len() - 10);
     }
     println!(
         "  {} {}: {}/{} runs passed",
