@@ -412,3 +412,51 @@ fn each_inversion_starts_from_the_previous_one_and_a_restart_from_zero() {
     run(&mut ctl, &model, &mut plant, 200);
     check(&model.calls.borrow());
 }
+
+/// Steps until the loop leaves idle (at most `limit`), and the output of that step.
+fn steps_to_close<M: FrictionModel>(
+    ctl: &mut Controller,
+    model: &M,
+    plant: &mut Plant,
+    limit: usize,
+) -> (usize, Output) {
+    for k in 1..=limit {
+        let out = run(ctl, model, plant, 1);
+        if out.state != S::Idle {
+            return (k, out);
+        }
+        assert_eq!(out.amplitude, Q1_31::ZERO, "drive off while idle, step {k}");
+    }
+    panic!("the loop did not close within {limit} steps");
+}
+
+#[test]
+fn the_loop_first_closes_on_a_learned_natural_friction() {
+    // The scene's coefficient (the prior) is 0.2, the plant's 0.3.
+    let settings = |learn_s: f64| Settings {
+        natural_prior: 0.2,
+        natural_prior_weight: 0,
+        natural_learn_s: learn_s,
+        ..Settings::REFERENCE
+    };
+    let close = |learn_s: f64| {
+        let mut ctl = Controller::new(Config::new(&settings(learn_s)).unwrap());
+        let model = LittmannModel::new(0.0754);
+        let mut plant = Plant::new(0.3, 0.0754 * 0.9, 0.8e-3, T, 3);
+        ctl.set_target(HALF).unwrap();
+        ctl.start().unwrap();
+        steps_to_close(&mut ctl, &model, &mut plant, 200)
+    };
+    let (at_once, _) = close(0.0);
+    let (learned, out) = close(3e-3);
+    // 3 ms of sliding with the drive off: 30 samples of mu0, the first taken in the step that
+    // confirms the sliding (where the loop closed at once before).
+    assert_eq!(learned, at_once + 29, "{at_once} {learned}");
+    assert_eq!(out.state, S::RampUp);
+    // With the prior worth nothing, mu0 is the plant's coefficient, not the scene's.
+    let mu0 = out.natural_coefficient.to_f64();
+    assert!((mu0 - 0.3).abs() < 0.002, "{mu0}");
+    // A learning time longer than the averaging window is refused.
+    assert!(Config::new(&settings(0.5)).is_err());
+    assert!(Config::new(&settings(-1e-3)).is_err());
+}

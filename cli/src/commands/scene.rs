@@ -7,7 +7,13 @@
 //! ```text
 //! sonolube scene NAME [--out DIR] [--file PATH.toml]
 //! sonolube scene --all [--out DIR]
+//! sonolube scene NAME|--all --seeds N|A-B [--plot PATH.svg]
+//! sonolube scene NAME --mismatch|--envelope|--noise [--seeds N|A-B] [--out DIR]
 //! ```
+//!
+//! `--seeds`, `--mismatch`, `--envelope` and `--noise` are the robustness sweeps ([`robust`]):
+//! many runs over every core, a table per criterion (pass rate, percentiles, worst run), a
+//! closing one-line summary, exit 0 only when every run passes.
 //!
 //! `NAME` is a built-in scene (`scenes/*.toml`, compiled in); `--file` runs any scene file
 //! (its `name` must match `NAME` when both are given). Files go to `DIR` (default
@@ -43,7 +49,11 @@
 
 mod csv;
 mod figure;
+mod grid;
 mod report;
+pub mod robust;
+mod spread;
+mod sweep;
 mod why;
 
 use std::fmt::Write as _;
@@ -60,10 +70,12 @@ pub use csv::csv;
 pub use report::{model_line, model_name, short};
 
 const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml] [--model VARIANT]\n       \
-                     sonolube scene --all [--out DIR]\n\
-                     exit status: 0 every criterion passes; 1 one fails, or the scene cannot \
-                     run (a file that cannot be read or is invalid, values that cannot build a \
-                     run); 2 a usage error\n";
+                     sonolube scene --all [--out DIR]\n       \
+                     sonolube scene NAME|--all --seeds N|A-B [--plot PATH.svg]\n       \
+                     sonolube scene NAME --mismatch|--envelope|--noise [--seeds N|A-B] [--out DIR]\n\
+                     exit status: 0 every criterion passes (every run of a sweep); 1 one fails, \
+                     or the scene cannot run (a file that cannot be read or is invalid, values \
+                     that cannot build a run); 2 a usage error\n";
 
 /// Entry point: `args` are the arguments after `scene`.
 pub fn run(args: &[String]) -> ExitCode {
@@ -72,23 +84,39 @@ pub fn run(args: &[String]) -> ExitCode {
     let mut file = None;
     let mut forced = None;
     let mut all = false;
+    let mut seeds = None;
+    let mut plot = None;
+    let mut sweep = None;
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
         match arg.as_str() {
             "--all" => all = true,
-            "--out" | "--file" | "--model" => {
+            "--mismatch" | "--envelope" | "--noise" => {
+                if sweep.is_some() {
+                    return usage("one of --mismatch, --envelope, --noise at a time");
+                }
+                sweep = Some(match arg.as_str() {
+                    "--mismatch" => robust::Sweep::Mismatch,
+                    "--envelope" => robust::Sweep::Envelope,
+                    _ => robust::Sweep::Noise,
+                });
+            }
+            "--out" | "--file" | "--model" | "--seeds" | "--plot" => {
                 let Some(value) = rest.next() else {
                     return usage(&format!("{arg} needs a value"));
                 };
-                if arg == "--out" {
-                    out = PathBuf::from(value);
-                } else if arg == "--file" {
-                    file = Some(PathBuf::from(value));
-                } else {
-                    match sonolube::variant::find(value) {
+                match arg.as_str() {
+                    "--out" => out = PathBuf::from(value),
+                    "--file" => file = Some(PathBuf::from(value)),
+                    "--plot" => plot = Some(PathBuf::from(value)),
+                    "--model" => match sonolube::variant::find(value) {
                         Some(v) if v.form == sonolube::variant::Form::Fixed => forced = Some(v),
                         _ => return usage(&format!("no fixed-point model variant '{value}'")),
-                    }
+                    },
+                    _ => match robust::parse_seeds(value) {
+                        Ok(list) => seeds = Some(list),
+                        Err(problem) => return usage(&problem),
+                    },
                 }
             }
             "-h" | "--help" => {
@@ -100,9 +128,26 @@ pub fn run(args: &[String]) -> ExitCode {
             _ => return usage(&format!("unexpected argument {arg}")),
         }
     }
+    let robust = seeds.is_some() || sweep.is_some();
+    if plot.is_some() && !robust {
+        return usage("--plot goes with --seeds, --mismatch, --envelope or --noise");
+    }
     if all {
         if name.is_some() || file.is_some() || forced.is_some() {
             return usage("--all takes no scene name, --file or --model");
+        }
+        if sweep.is_some() {
+            return usage("--mismatch, --envelope and --noise take one scene NAME, not --all");
+        }
+        if let Some(seeds) = &seeds {
+            let scenes = robust::builtin();
+            return robust::run(
+                &scenes,
+                robust::Sweep::Seeds,
+                Some(seeds),
+                plot.as_deref(),
+                &out,
+            );
         }
         return run_all(&out);
     }
@@ -128,6 +173,18 @@ pub fn run(args: &[String]) -> ExitCode {
         },
         (None, None) => return usage("a scene NAME, --file or --all is needed"),
     };
+    if robust {
+        if forced.is_some() {
+            return usage("--model goes with a single run, not a sweep");
+        }
+        return robust::run(
+            &[scene],
+            sweep.unwrap_or(robust::Sweep::Seeds),
+            seeds.as_deref(),
+            plot.as_deref(),
+            &out,
+        );
+    }
     match run_forced(&scene, &out, forced) {
         Ok(run) => {
             print!("{}", run.report);

@@ -1,0 +1,323 @@
+//! The robustness modes of `sonolube scene`: a scene (or every scene) over many noise seeds,
+//! over the mismatch grid, over the operating envelope and over sensor noise levels.
+//!
+//! ```text
+//! sonolube scene NAME --seeds N|A-B [--plot PATH.svg]
+//! sonolube scene --all --seeds N|A-B [--plot PATH.svg]
+//! sonolube scene NAME --mismatch [--seeds N|A-B]
+//! sonolube scene NAME --envelope [--seeds N|A-B] [--out DIR]
+//! sonolube scene NAME --noise [--seeds N|A-B]
+//! ```
+//!
+//! Each prints, per scene and criterion, the pass rate, the 50th, 90th and 99th percentiles
+//! and the worst run; then the failed runs; and ends with a one-line summary. The exit status
+//! is 0 only when every run passes every criterion (1 otherwise, 2 for a usage error). The
+//! sweeps without `--seeds` run on the scene's own seed. `SONOLUBE_JOBS` caps the threads.
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use sonolube::scene::{SCENES, Scene};
+use sonolube_sim::RunSummary;
+
+use super::grid::{
+    ENVELOPE_LOADS_N, ENVELOPE_SPEEDS, NOISE_LEVELS_PCT, envelope_points, load_text, mismatch_runs,
+    with_noise,
+};
+use super::spread;
+use super::sweep::{
+    Run, all_passed, criterion_stats, failures, percentile, run_all, stats_table, threads, value_of,
+};
+use crate::scene_file::scenes_dir;
+
+/// Which robustness sweep.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sweep {
+    /// Noise seeds only.
+    Seeds,
+    /// The mismatch grid ([`super::grid::Mismatch::grid`]).
+    Mismatch,
+    /// The operating envelope ([`super::grid::envelope_points`]).
+    Envelope,
+    /// Sensor noise levels ([`NOISE_LEVELS_PCT`]).
+    Noise,
+}
+
+/// Parses `N` (seeds 1 to N) or `A-B` (A to B, inclusive); at most 100 000 seeds.
+pub fn parse_seeds(text: &str) -> Result<Vec<u64>, String> {
+    let bad = || format!("--seeds takes N or A-B (positive whole numbers), not '{text}'");
+    let (from, to) = match text.split_once('-') {
+        Some((a, b)) => (
+            a.parse::<u64>().map_err(|_| bad())?,
+            b.parse::<u64>().map_err(|_| bad())?,
+        ),
+        None => (1, text.parse::<u64>().map_err(|_| bad())?),
+    };
+    if from == 0 || to < from || to - from >= 100_000 {
+        return Err(bad());
+    }
+    Ok((from..=to).collect())
+}
+
+fn seeds_text(seeds: &[u64]) -> String {
+    match (seeds.first(), seeds.last()) {
+        (Some(a), Some(b)) if a != b => format!("seeds {a}-{b}"),
+        (Some(a), _) => format!("seed {a}"),
+        _ => String::from("no seed"),
+    }
+}
+
+/// Runs a sweep of the `scenes` (several only for [`Sweep::Seeds`]); `seeds` `None` means each
+/// scene's own seed. `plot` writes the distributions' SVG; `out` receives the envelope files.
+pub fn run(
+    scenes: &[Scene<'_>],
+    sweep: Sweep,
+    seeds: Option<&[u64]>,
+    plot: Option<&Path>,
+    out: &Path,
+) -> ExitCode {
+    let jobs = threads();
+    let mut passed_scenes = 0;
+    let mut total_runs = 0;
+    let mut failed_runs = 0;
+    let mut all = Vec::new();
+    for scene in scenes {
+        let own = [scene.noise_seed];
+        let seeds = seeds.unwrap_or(&own);
+        let result = match sweep {
+            Sweep::Seeds => {
+                let runs: Vec<Run<'_>> = seeds.iter().map(|&s| Run::seeded(scene, s)).collect();
+                println!("{}: {} runs, {}", scene.name, runs.len(), seeds_text(seeds));
+                sweep_runs(scene, &runs, jobs)
+            }
+            Sweep::Mismatch => {
+                let runs = mismatch_runs(scene, seeds);
+                println!(
+                    "{}: mismatch grid (plant mu x0.7/1/1.3, k_t x0.5/1/2, cell gain -2/0/+2 %, \
+                     resonance -0.5/0/+0.5 % of f0), {} runs, {}",
+                    scene.name,
+                    runs.len(),
+                    seeds_text(seeds)
+                );
+                sweep_runs(scene, &runs, jobs)
+            }
+            Sweep::Noise => noise_sweep(scene, seeds, jobs),
+            Sweep::Envelope => envelope(scene, seeds, jobs, out),
+        };
+        match result {
+            Ok(done) => {
+                total_runs += done.results.len();
+                let failed = done.results.iter().filter(|r| !is_pass(r)).count();
+                failed_runs += failed;
+                if failed == 0 {
+                    passed_scenes += 1;
+                }
+                all.push((scene.name.to_string(), done));
+            }
+            Err(error) => {
+                println!("  cannot sweep {}: {error}", scene.name);
+                failed_runs += 1;
+            }
+        }
+    }
+    if let Some(path) = plot {
+        let svg = spread::svg(&all);
+        match std::fs::write(path, svg) {
+            Ok(()) => println!("wrote {}", path.display()),
+            Err(e) => {
+                eprintln!("sonolube scene: {}: {e}", path.display());
+                return ExitCode::FAILURE;
+            }
+        }
+    }
+    println!(
+        "{} of {} scenes passed every run; {} of {} runs failed ({}, {jobs} threads)",
+        passed_scenes,
+        scenes.len(),
+        failed_runs,
+        total_runs,
+        seeds.map_or(String::from("own seeds"), seeds_text)
+    );
+    if failed_runs == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}
+
+fn is_pass(result: &Result<RunSummary, String>) -> bool {
+    result.as_ref().is_ok_and(RunSummary::passed)
+}
+
+/// A finished sweep of one scene: its criteria's statistics and the results.
+pub struct Done {
+    /// Per criterion.
+    pub stats: Vec<super::sweep::CriterionStats>,
+    /// Per run.
+    pub results: Vec<Result<RunSummary, String>>,
+}
+
+/// Runs `runs` of `scene` and prints their table and failures.
+fn sweep_runs(scene: &Scene<'_>, runs: &[Run<'_>], jobs: usize) -> Result<Done, String> {
+    let results = run_all(runs, jobs, scene.name);
+    let stats = criterion_stats(scene, runs, &results);
+    print!("{}", stats_table(&stats));
+    for line in failures(runs, &results) {
+        println!("  FAIL {line}");
+    }
+    println!(
+        "  {} {}: {}/{} runs passed",
+        if all_passed(&results) { "PASS" } else { "FAIL" },
+        scene.name,
+        results.iter().filter(|r| is_pass(r)).count(),
+        results.len()
+    );
+    Ok(Done { stats, results })
+}
+
+/// The noise sweep: the scene with both cells' noise at each level of [`NOISE_LEVELS_PCT`],
+/// on every seed; prints the RMS error (first steady-RMS criterion) against the noise and the
+/// growth between levels (error ratio over noise ratio, at most 1 when the error grows no
+/// faster than the noise).
+fn noise_sweep(scene: &Scene<'_>, seeds: &[u64], jobs: usize) -> Result<Done, String> {
+    let rms_index = scene
+        .criteria
+        .iter()
+        .position(|c| matches!(c, sonolube::scene::Criterion::SteadyRmsError { .. }))
+        .ok_or("the scene has no steady RMS criterion to sweep")?;
+    let runs: Vec<Run<'_>> = NOISE_LEVELS_PCT
+        .iter()
+        .flat_map(|&pct| seeds.iter().map(move |&seed| with_noise(scene, pct, seed)))
+        .collect();
+    println!(
+        "{}: sensor noise sweep, both cells at {:?} % FS, {} runs, {}",
+        scene.name,
+        NOISE_LEVELS_PCT,
+        runs.len(),
+        seeds_text(seeds)
+    );
+    let results = run_all(&runs, jobs, scene.name);
+    println!(
+        "  {:>10} {:>12} {:>12} {:>12} {:>10} {:>8}",
+        "noise % FS", "RMS mean %", "RMS p90 %", "RMS worst %", "growth", "pass"
+    );
+    let mut previous: Option<(f64, f64)> = None;
+    for (level, chunk) in NOISE_LEVELS_PCT.iter().zip(results.chunks(seeds.len())) {
+        let mut values: Vec<f64> = chunk
+            .iter()
+            .filter_map(|r| r.as_ref().ok())
+            .filter_map(|s| s.verdicts.get(rms_index).and_then(|v| value_of(v.measured)))
+            .collect();
+        values.sort_by(f64::total_cmp);
+        let mean = values.iter().sum::<f64>() / values.len().max(1) as f64;
+        let growth = previous.map_or(String::from("-"), |(noise, error)| {
+            format!("{:.2}", (mean / error) / (level / noise))
+        });
+        println!(
+            "  {:>10} {:>12.3} {:>12.3} {:>12.3} {:>10} {:>8}",
+            level,
+            mean,
+            percentile(&values, 90.0).unwrap_or(f64::NAN),
+            values.last().copied().unwrap_or(f64::NAN),
+            growth,
+            format!(
+                "{}/{}",
+                chunk.iter().filter(|r| is_pass(r)).count(),
+                chunk.len()
+            )
+        );
+        previous = Some((*level, mean));
+    }
+    println!(
+        "  (growth: RMS error ratio over noise ratio from the level above; <= 1 grows no faster than the noise)"
+    );
+    let stats = criterion_stats(scene, &runs, &results);
+    Ok(Done { stats, results })
+}
+
+/// The envelope sweep: a scene file per point, written to `out/envelope/`, run on every seed.
+fn envelope(scene: &Scene<'_>, seeds: &[u64], jobs: usize, out: &Path) -> Result<Done, String> {
+    if scene.name != "reference" {
+        return Err(String::from(
+            "the envelope is made from the reference scene's file: run it on 'reference'",
+        ));
+    }
+    let template = std::fs::read_to_string(scenes_dir().join("reference.toml"))
+        .map_err(|e| format!("scenes/reference.toml: {e}"))?;
+    let points = envelope_points(&template, scene)?;
+    let dir = out.join("envelope");
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut loaded = Vec::new();
+    for point in &points {
+        let file = load_text(&point.toml, "envelope")?;
+        let path = dir.join(format!("{}.toml", file.scene().name));
+        std::fs::write(&path, &point.toml).map_err(|e| format!("{}: {e}", path.display()))?;
+        loaded.push(file);
+    }
+    let mut runs = Vec::new();
+    for (point, file) in points.iter().zip(&loaded) {
+        for &seed in seeds {
+            let mut run = Run::seeded(&file.scene(), seed);
+            run.label = format!(
+                "{} N, {} m/s, {:.1} % of {:.1} % reachable, seed {seed}",
+                point.load_n, point.speed_m_per_s, point.reduction_pct, point.reachable_pct
+            );
+            runs.push(run);
+        }
+    }
+    println!(
+        "{}: operating envelope, loads {:?} N x speeds {:?} m/s x targets 10/35/60 % of the \
+         reachable reduction, {} scene files in {}, {} runs, {}",
+        scene.name,
+        ENVELOPE_LOADS_N,
+        ENVELOPE_SPEEDS,
+        points.len(),
+        dir.display(),
+        runs.len(),
+        seeds_text(seeds)
+    );
+    let results = run_all(&runs, jobs, "envelope");
+    let stats = criterion_stats(scene, &runs, &results);
+    print!("{}", stats_table(&stats));
+    // Pass counts per (load, speed).
+    println!("  runs passed per load (rows, N) and speed (columns, m/s):");
+    print!("  {:>6}", "");
+    for speed in ENVELOPE_SPEEDS {
+        print!(" {speed:>8}");
+    }
+    println!();
+    let per_point = seeds.len() * super::grid::ENVELOPE_SHARES.len();
+    for (row, load) in ENVELOPE_LOADS_N.iter().enumerate() {
+        print!("  {load:>6}");
+        for column in 0..ENVELOPE_SPEEDS.len() {
+            let start = (row * ENVELOPE_SPEEDS.len() + column) * per_point;
+            let chunk = &results[start..start + per_point];
+            let ok = chunk.iter().filter(|r| is_pass(r)).count();
+            print!(" {:>8}", format!("{ok}/{per_point}"));
+        }
+        println!();
+    }
+    for line in failures(&runs, &results) {
+        println!("  FAIL {line}");
+    }
+    Ok(Done { stats, results })
+}
+
+/// The built-in scenes.
+pub fn builtin() -> Vec<Scene<'static>> {
+    SCENES.to_vec()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn seeds_parse_as_a_count_or_a_range_and_refuse_the_rest() {
+        assert_eq!(parse_seeds("3"), Ok(vec![1, 2, 3]));
+        assert_eq!(parse_seeds("7-9"), Ok(vec![7, 8, 9]));
+        for bad in ["0", "", "x", "5-2", "-3", "1-", "0-4", "1-200000"] {
+            assert!(parse_seeds(bad).is_err(), "{bad}");
+        }
+    }
+}
