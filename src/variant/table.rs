@@ -17,27 +17,27 @@ pub static MEASURED: Measurements = Measurements {
 static COSTS: &[Cost] = &[
     Cost {
         variant: "Littmann closed form",
-        instructions: 45.093,
+        instructions: 42.106,
     },
     Cost {
         variant: "Littmann closed form f32 micromath",
-        instructions: 33.853,
+        instructions: 30.866,
     },
     Cost {
         variant: "Littmann closed form f32 libm",
-        instructions: 417.807,
+        instructions: 414.782,
     },
     Cost {
         variant: "Littmann closed form f64",
-        instructions: 3356.017,
+        instructions: 3355.998,
     },
     Cost {
         variant: "Dahl update",
-        instructions: 43.76,
+        instructions: 43.863,
     },
     Cost {
         variant: "Dahl update f32 micromath",
-        instructions: 107.247,
+        instructions: 107.213,
     },
     Cost {
         variant: "Dahl update f32 libm",
@@ -45,83 +45,83 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl update f64",
-        instructions: 2228.034,
+        instructions: 2228.068,
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 314.523,
+        instructions: 315.294,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 68.809,
+        instructions: 68.627,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 245.535,
+        instructions: 259.215,
     },
     Cost {
         variant: "Coulomb ratio f64",
-        instructions: 2704.583,
+        instructions: 2719.95,
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11246.333,
+        instructions: 11353.494,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 6011.933,
+        instructions: 5869.301,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 32539.266,
+        instructions: 31789.516,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 149775.53,
+        instructions: 147229.19,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20021.732,
+        instructions: 20281.129,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
-        instructions: 11565.933,
+        instructions: 11294.784,
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 59899.266,
+        instructions: 58560.97,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 274442.53,
+        instructions: 269833.94,
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 37425.664,
+        instructions: 37995.86,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22702.332,
+        instructions: 22175.912,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 114337.664,
+        instructions: 111755.86,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 519900.28,
+        instructions: 511143.0,
     },
     Cost {
         variant: "Dahl steady T=33x33",
-        instructions: 915.8,
+        instructions: 910.645,
     },
     Cost {
         variant: "Dahl steady T=65x65",
-        instructions: 917.733,
+        instructions: 912.043,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 592.121,
+        instructions: 591.969,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
@@ -129,19 +129,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 260.454,
+        instructions: 260.303,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9423.787,
+        instructions: 9423.333,
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 829.848,
+        instructions: 830.0,
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 631.666,
+        instructions: 631.969,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
@@ -149,11 +149,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15228.484,
+        instructions: 15228.636,
     },
     Cost {
         variant: "cube el N=16",
-        instructions: 1305.909,
+        instructions: 1305.757,
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
@@ -161,11 +161,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=16 f32 libm",
-        instructions: 647.272,
+        instructions: 646.969,
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26879.242,
+        instructions: 26879.545,
     },
     Cost {
         variant: "cube el N=32",
@@ -173,31 +173,31 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.515,
+        instructions: 2161.666,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
-        instructions: 1162.727,
+        instructions: 1162.878,
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50124.09,
+        instructions: 50122.88,
     },
     Cost {
         variant: "cube el T=5x5",
-        instructions: 282.727,
-    },
-    Cost {
-        variant: "cube el T=9x9",
         instructions: 282.575,
     },
     Cost {
+        variant: "cube el T=9x9",
+        instructions: 282.727,
+    },
+    Cost {
         variant: "cube el T=17x17",
-        instructions: 282.878,
+        instructions: 282.575,
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 591.818,
+        instructions: 592.121,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
@@ -205,19 +205,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
-        instructions: 260.454,
+        instructions: 260.606,
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9414.848,
+        instructions: 9414.696,
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 830.0,
+        instructions: 829.696,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 631.969,
+        instructions: 632.121,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
@@ -229,7 +229,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1305.757,
+        instructions: 1305.909,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
@@ -237,27 +237,27 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 647.272,
+        instructions: 646.969,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26868.03,
+        instructions: 26867.879,
     },
     Cost {
         variant: "cube ep N=32",
-        instructions: 2257.878,
+        instructions: 2257.727,
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
-        instructions: 2161.363,
+        instructions: 2161.515,
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
-        instructions: 1162.878,
+        instructions: 1162.727,
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50110.91,
+        instructions: 50111.21,
     },
     Cost {
         variant: "cube ep T=5x5",
@@ -265,7 +265,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep T=9x9",
-        instructions: 282.575,
+        instructions: 282.424,
     },
     Cost {
         variant: "cube ep T=17x17",
@@ -820,6 +820,104 @@ static ERRORS: &[SceneError] = &[
         variant: "Dahl steady T=65x65",
         reference: Fidelity::DahlSteady,
         max_error: 2.29e-5,
+        points: 24,
+    },
+    SceneError {
+        scene: "resonance-drift",
+        variant: "Coulomb ratio",
+        reference: Fidelity::Coulomb,
+        max_error: 4.79e-10,
+        points: 120,
+    },
+    SceneError {
+        scene: "resonance-drift",
+        variant: "Coulomb ratio",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.209,
+        points: 120,
+    },
+    SceneError {
+        scene: "resonance-drift",
+        variant: "Dahl steady N=16",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.00697,
+        points: 120,
+    },
+    SceneError {
+        scene: "resonance-drift",
+        variant: "Dahl steady N=32",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.0018,
+        points: 120,
+    },
+    SceneError {
+        scene: "resonance-drift",
+        variant: "Dahl steady N=64",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.000453,
+        points: 120,
+    },
+    SceneError {
+        scene: "resonance-drift",
+        variant: "Dahl steady T=33x33",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.000382,
+        points: 120,
+    },
+    SceneError {
+        scene: "resonance-drift",
+        variant: "Dahl steady T=65x65",
+        reference: Fidelity::DahlSteady,
+        max_error: 3.21e-5,
+        points: 120,
+    },
+    SceneError {
+        scene: "resonance-search",
+        variant: "Coulomb ratio",
+        reference: Fidelity::Coulomb,
+        max_error: 9.27e-10,
+        points: 24,
+    },
+    SceneError {
+        scene: "resonance-search",
+        variant: "Coulomb ratio",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.184,
+        points: 24,
+    },
+    SceneError {
+        scene: "resonance-search",
+        variant: "Dahl steady N=16",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.00701,
+        points: 24,
+    },
+    SceneError {
+        scene: "resonance-search",
+        variant: "Dahl steady N=32",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.00182,
+        points: 24,
+    },
+    SceneError {
+        scene: "resonance-search",
+        variant: "Dahl steady N=64",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.000457,
+        points: 24,
+    },
+    SceneError {
+        scene: "resonance-search",
+        variant: "Dahl steady T=33x33",
+        reference: Fidelity::DahlSteady,
+        max_error: 0.000184,
+        points: 24,
+    },
+    SceneError {
+        scene: "resonance-search",
+        variant: "Dahl steady T=65x65",
+        reference: Fidelity::DahlSteady,
+        max_error: 2.62e-5,
         points: 24,
     },
     SceneError {
