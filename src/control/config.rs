@@ -44,14 +44,10 @@ pub struct Settings {
     pub sliding_debounce_s: f64,
     /// The scene's friction coefficient, the prior of the natural friction.
     pub natural_prior: f64,
-    /// How many samples the prior is worth (0: it only stands in until the first sample).
+    /// How many samples the prior is worth.
     pub natural_prior_weight: u32,
     /// Averaging window of the natural friction once learned, s.
     pub natural_window_s: f64,
-    /// Natural friction learned (sliding, drive off) before the loop first closes, s, in
-    /// [0, `natural_window_s`]: the drive waits in idle until mu0 holds this many samples
-    /// besides the prior. 0: the loop closes as soon as sliding is confirmed.
-    pub natural_learn_s: f64,
     /// Estimated vibration amplitude below which the drive counts as off for learning,
     /// fraction of full scale.
     pub natural_max_drive: f64,
@@ -104,7 +100,6 @@ impl Settings {
         natural_prior: 0.3,
         natural_prior_weight: 4,
         natural_window_s: 0.2,
-        natural_learn_s: 0.0,
         natural_max_drive: 1e-3,
         envelope_time_constant_s: 0.8e-3,
         response_time_constant_s: 0.25e-3,
@@ -230,18 +225,9 @@ impl Config {
         let prior = Q2_30::from_f64(prior).map_err(|_| ConfigError::OutOfRange {
             setting: "natural_prior",
         })?;
-        let prior_weight = s.natural_prior_weight;
-        let window = steps(positive(s.natural_window_s, "natural_window_s")?, period)
-            .max(prior_weight.max(1));
-        let learn = s.natural_learn_s;
-        if !(learn.is_finite() && learn >= 0.0 && learn <= s.natural_window_s) {
-            return Err(ConfigError::OutOfRange {
-                setting: "natural_learn_s",
-            });
-        }
-        let ready = prior_weight
-            .saturating_add(libm::round(learn / period).min(u32::MAX as f64) as u32)
-            .min(window);
+        let prior_weight = s.natural_prior_weight.max(1);
+        let window =
+            steps(positive(s.natural_window_s, "natural_window_s")?, period).max(prior_weight);
         let debounce = s.sliding_debounce_s;
         if !(debounce.is_finite() && debounce >= 0.0) {
             return Err(ConfigError::OutOfRange {
@@ -270,7 +256,6 @@ impl Config {
                 prior,
                 prior_weight,
                 window,
-                ready,
             },
             natural_max_drive: fraction(s.natural_max_drive, "natural_max_drive")?,
             shaper: ShaperConfig::new(

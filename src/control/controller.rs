@@ -168,15 +168,7 @@ impl Controller {
         if s.contact == Contact::Ok && drive_off && s.supervisor.state() != SupervisorState::Fault {
             s.natural.learn(&c.natural, s.estimate.coefficient);
         }
-        // The loop first closes once mu0 is learned: a reduction is relative to it, and a mu0
-        // off by x % holds every later target x % off. Losing the contact is followed always.
-        let closing = matches!(
-            s.supervisor.state(),
-            SupervisorState::Idle | SupervisorState::RampDown
-        );
-        if !closing || s.natural.is_ready(&c.natural) {
-            s.supervisor.follow_contact(s.contact, s.shaper.command());
-        }
+        s.supervisor.follow_contact(s.contact, s.shaper.command());
     }
 
     /// Closing the loop starts from rest: no correction, prediction re-seeded, fast gains.

@@ -132,13 +132,10 @@ impl Default for FrictionEstimator {
 pub struct NaturalConfig {
     /// The scene's friction coefficient, the starting value, Q2.30 in [1e-3, 2).
     pub prior: Q2_30,
-    /// How many samples the prior is worth (0: the first sample replaces it).
+    /// How many samples the prior is worth (>= 1).
     pub prior_weight: u32,
     /// Length of the averaging window once learned, samples (>= `prior_weight`).
     pub window: u32,
-    /// Weight (prior plus samples) from which mu0 is good enough to close the loop on,
-    /// in [`prior_weight`, `window`].
-    pub ready: u32,
 }
 
 /// The learned natural friction coefficient `mu0`.
@@ -156,7 +153,7 @@ impl NaturalFriction {
         let coefficient = config.prior.max(MIN_NATURAL_COEF);
         Self {
             coefficient,
-            weight: config.prior_weight,
+            weight: config.prior_weight.max(1),
             reciprocal: Reciprocal::of(coefficient).unwrap_or(Reciprocal::ONE),
         }
     }
@@ -181,11 +178,6 @@ impl NaturalFriction {
     /// `1 / mu0`.
     pub const fn reciprocal(&self) -> Reciprocal {
         self.reciprocal
-    }
-
-    /// Whether mu0 has learned enough to close the loop on ([`NaturalConfig::ready`]).
-    pub const fn is_ready(&self, config: &NaturalConfig) -> bool {
-        self.weight >= config.ready
     }
 
     /// The weight of the present value in samples (prior weight plus samples learned, up to
@@ -239,17 +231,13 @@ mod tests {
             prior: Q2_30::from_f64(0.3).unwrap(),
             prior_weight: 16,
             window: 2_000,
-            ready: 20,
         };
         let mut natural = NaturalFriction::new(&cfg);
         assert_eq!(natural.coefficient(), cfg.prior);
-        assert!(!natural.is_ready(&cfg));
         // The true coefficient is 20 % higher, seen through +-0.02 alternating noise.
         for k in 0..1_000 {
             let noise = if k % 2 == 0 { 0.02 } else { -0.02 };
             natural.learn(&cfg, Q2_30::from_f64(0.36 + noise).unwrap());
-            // Ready after the prior's 16 and 4 samples.
-            assert_eq!(natural.is_ready(&cfg), k >= 3, "{k}");
         }
         // Running mean with the prior worth 16 of 1016 samples: 0.36 - 0.06 * 16 / 1016.
         let want = 0.36 - 0.06 * 16.0 / 1016.0;

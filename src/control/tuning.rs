@@ -26,13 +26,11 @@ pub const FORCE_FILTER_HZ: f64 = 250.0;
 /// Weight of the scene's coefficient as the prior of mu0, samples.
 ///
 /// The scene's coefficient is known to +-20 % (the acceptance mismatch), one sample of the
-/// natural coefficient to 1-2 %: the prior is worth far less than one sample. With 4, the 5 ms of
-/// natural friction before the reference step left mu0 1.5 % low (0.2365 for the plant's 0.24),
-/// and as the reduction target is relative to mu0, the steady error was 1.8 % RMS (limit 1 %);
-/// with 1 it still held the reference 0.37 % low without noise (1/41 of the 17 % mismatch),
-/// which the noise then pushed past the 2 % settling band on some seeds. With 0 the prior only
-/// stands in until the first sample; the loop never closes on it ([`NATURAL_LEARN_S`]).
-pub const NATURAL_PRIOR_WEIGHT: u32 = 0;
+/// natural coefficient to 1-2 %: the prior is worth far less than one sample, and 1 is the least
+/// the learner takes. With 4, the 5 ms of natural friction before the reference step left mu0
+/// 1.5 % low (0.2365 for the plant's 0.24), and as the reduction target is relative to mu0, the
+/// steady error was 1.8 % RMS (limit 1 %).
+pub const NATURAL_PRIOR_WEIGHT: u32 = 1;
 
 /// Sliding debounce, s.
 ///
@@ -40,17 +38,6 @@ pub const NATURAL_PRIOR_WEIGHT: u32 = 0;
 /// step (against a 2 ms debounce) takes the prior's share of mu0 from 1/31 to 1/41. A velocity
 /// glitch of up to 10 samples at 10 kHz is still ignored.
 pub const SLIDING_DEBOUNCE_S: f64 = 1e-3;
-
-/// Natural friction learned before the loop first closes, s.
-///
-/// A reduction target is relative to the learned mu0, so an error of mu0 is an error of every
-/// later target that no feedback removes (mu0 is learned with the drive off only). Closing the
-/// loop as soon as sliding was confirmed left mu0 a few filtered samples: at `stack-rail`'s
-/// 0.54 N (4 mN of tangential noise on 0.11 N of friction, 3.7 % a sample on each cell) that
-/// held whole runs up to 3.7 % RMS off (seed 48, limit 3 %; 3 of 100 seeds failed). 5 ms is 50
-/// samples: 0.7 % RMS of mu0 at that load, 0.2 % at the reference's 4.155 N. The drive starts
-/// 5 ms after sliding is confirmed; nothing is lost where the first target is no reduction.
-pub const NATURAL_LEARN_S: f64 = 3e-3;
 
 /// Steady-state PI gains: proportional (ratio per ratio) and integral (1/s).
 ///
@@ -109,7 +96,6 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
         sliding_debounce_s: SLIDING_DEBOUNCE_S,
         natural_prior: scene.controller.natural_coefficient(start_speed),
         natural_prior_weight: NATURAL_PRIOR_WEIGHT,
-        natural_learn_s: NATURAL_LEARN_S,
         envelope_time_constant_s: envelope,
         // The lead cannot make the envelope slower than it is.
         response_time_constant_s: libm::fmin(reference.response_time_constant_s, envelope),
