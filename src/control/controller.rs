@@ -3,7 +3,7 @@
 
 use super::config::Config;
 use super::error::ControlError;
-use super::estimate::{FrictionEstimate, FrictionEstimator, NaturalFriction};
+use super::estimate::{FrictionEstimate, FrictionEstimator, MIN_NATURAL_COEF, NaturalFriction};
 use super::filter::LowPass;
 use super::io::{Inputs, Output, Saturation};
 use super::pi::{Clamp, Pi, PiGains};
@@ -17,6 +17,32 @@ use super::target::PreparedTarget;
 use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
 use crate::model::{FrictionModel, ModelError, OperatingPoint, Reach};
 use crate::protocol::{SupervisorState, Target};
+
+/// The load at which a model whose load enters only through `mu W` (the Dahl steady state,
+/// [`FrictionModel::load_enters_as_coulomb_force`]) sees the measured Coulomb force: `W mu0 /
+/// mu`, with `mu0` the learned natural friction and `mu` the model's (the scene's prior).
+///
+/// Why: the Dahl steady state depends on `kappa x_a = k_t x_a / (mu W)`, the amplitude over the
+/// contact's elastic slip length `mu W / k_t`. That length is set by the real Coulomb force,
+/// which the controller measures (mu0, learned sliding with the drive off), not by the
+/// nominal `mu`. With the nominal value a plant whose mu is 20 % higher looks 20 % stiffer
+/// than it is, the inverse asks for too little amplitude and the PI has to find the whole
+/// difference. (k_t is not observable without vibration and stays nominal.)
+///
+/// `load` Q16.16 N > 0, `mu0` and `mu` Q2.30 (floored at [`MIN_NATURAL_COEF`] as the learner
+/// floors them). Rounded to nearest. Error `OutOfDomain` if `W mu0 / mu` does not fit Q16.16
+/// (>= 32768 N): never saturated.
+pub(super) fn coulomb_load(load: Q16_16, mu0: Q2_30, mu: Q2_30) -> Result<Q16_16, ModelError> {
+    let num = load.to_bits() as i64 * mu0.max(MIN_NATURAL_COEF).to_bits() as i64;
+    let den = mu.max(MIN_NATURAL_COEF).to_bits() as i64;
+    // |num| < 2^62, den in [2^20, 2^31): no overflow.
+    i32::try_from((num + den / 2) / den)
+        .map(Q16_16::from_bits)
+        .map_err(|_| ModelError::OutOfDomain {
+            input: "W mu0 / mu",
+            reason: "the load at the learned natural friction exceeds Q16.16",
+        })
+}
 
 /// The controller's state (separate from its [`Config`]; never re-allocated).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -215,8 +241,14 @@ impl Controller {
             report.saturation.integral_frozen = true;
             Q1_31::ZERO
         } else {
+            let load = estimate.normal_force.max(c.estimator.min_normal_force);
+            let normal_force = if model.load_enters_as_coulomb_force() {
+                coulomb_load(load, s.natural.coefficient(), c.natural.prior)?
+            } else {
+                load
+            };
             let point = OperatingPoint {
-                normal_force: estimate.normal_force.max(c.estimator.min_normal_force),
+                normal_force,
                 sliding_velocity: estimate.sliding_velocity.saturating_abs().value,
             };
             // The reference: what the model says the cells should read now, given the drive
