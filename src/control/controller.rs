@@ -29,19 +29,33 @@ use crate::protocol::{SupervisorState, Target};
 /// than it is, the inverse asks for too little amplitude and the PI has to find the whole
 /// difference. (k_t is not observable without vibration and stays nominal.)
 ///
-/// `load` Q16.16 N > 0, `mu0` and `mu` Q2.30 (floored at [`MIN_NATURAL_COEF`] as the learner
-/// floors them). Rounded to nearest. Error `OutOfDomain` if `W mu0 / mu` does not fit Q16.16
-/// (>= 32768 N): never saturated.
-pub(super) fn coulomb_load(load: Q16_16, mu0: Q2_30, mu: Q2_30) -> Result<Q16_16, ModelError> {
-    let num = load.to_bits() as i64 * mu0.max(MIN_NATURAL_COEF).to_bits() as i64;
+/// `mu0 / mu` as a factor in Q33.30 (an `i64`; `mu0` and `mu` Q2.30, floored at
+/// [`MIN_NATURAL_COEF`] as the learner floors them, so the factor is in (2^19, 2^42)). Rounded
+/// to nearest. The controller keeps it while `mu0` and `mu` stay put: the division runs when
+/// they change (learning happens with the drive off), not in every step.
+pub(super) fn coulomb_factor(mu0: Q2_30, mu: Q2_30) -> i64 {
+    let num = (mu0.max(MIN_NATURAL_COEF).to_bits() as i64) << 30;
     let den = mu.max(MIN_NATURAL_COEF).to_bits() as i64;
-    // |num| < 2^62, den in [2^20, 2^31): no overflow.
-    i32::try_from((num + den / 2) / den)
+    // num < 2^61, den in [2^20, 2^31): no overflow.
+    (num + den / 2) / den
+}
+
+/// `W mu0 / mu` for `load` Q16.16 N > 0 and `factor` = [`coulomb_factor`]`(mu0, mu)`, rounded
+/// to nearest (within 1.5 Q16.16 steps of the exact value: half a step of rounding, plus the
+/// factor's rounding, 2^-31, times W < 2^15 N). Error `OutOfDomain` if it does not
+/// fit Q16.16 (>= 32768 N): never saturated.
+pub(super) fn coulomb_load(load: Q16_16, factor: i64) -> Result<Q16_16, ModelError> {
+    let too_large = ModelError::OutOfDomain {
+        input: "W mu0 / mu",
+        reason: "the load at the learned natural friction exceeds Q16.16",
+    };
+    let product = (load.to_bits() as i64)
+        .checked_mul(factor)
+        .and_then(|p| p.checked_add(1 << 29))
+        .ok_or(too_large)?;
+    i32::try_from(product >> 30)
         .map(Q16_16::from_bits)
-        .map_err(|_| ModelError::OutOfDomain {
-            input: "W mu0 / mu",
-            reason: "the load at the learned natural friction exceeds Q16.16",
-        })
+        .map_err(|_| too_large)
 }
 
 /// The controller's state (separate from its [`Config`]; never re-allocated).
@@ -63,6 +77,8 @@ pub struct ControllerState {
     /// the next inversion starts ([`FrictionModel::invert_from`]); zero from each ramp-up.
     feedforward: Q1_31,
     target: Option<(Target, PreparedTarget)>,
+    /// The `mu0` and `mu` of the last [`coulomb_factor`], and the factor (Q33.30).
+    coulomb: (Q2_30, Q2_30, i64),
 }
 
 /// The friction controller: configuration plus state.
@@ -108,6 +124,7 @@ impl Controller {
                 prediction_valid: false,
                 feedforward: Q1_31::ZERO,
                 target: None,
+                coulomb: (Q2_30::ZERO, Q2_30::ZERO, 1 << 30),
             },
             config,
         }
@@ -243,7 +260,11 @@ impl Controller {
         } else {
             let load = estimate.normal_force.max(c.estimator.min_normal_force);
             let normal_force = if model.load_enters_as_coulomb_force() {
-                coulomb_load(load, s.natural.coefficient(), c.natural.prior)?
+                let (mu0, mu) = (s.natural.coefficient(), c.natural.prior);
+                if (s.coulomb.0, s.coulomb.1) != (mu0, mu) {
+                    s.coulomb = (mu0, mu, coulomb_factor(mu0, mu));
+                }
+                coulomb_load(load, s.coulomb.2)?
             } else {
                 load
             };
