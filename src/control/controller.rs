@@ -3,7 +3,7 @@
 
 use super::config::Config;
 use super::error::ControlError;
-use super::estimate::{FrictionEstimate, FrictionEstimator, NaturalFriction};
+use super::estimate::{FrictionEstimate, FrictionEstimator, MIN_NATURAL_COEF, NaturalFriction};
 use super::filter::LowPass;
 use super::io::{Inputs, Output, Saturation};
 use super::pi::{Clamp, Pi, PiGains};
@@ -17,6 +17,46 @@ use super::target::PreparedTarget;
 use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
 use crate::model::{FrictionModel, ModelError, OperatingPoint, Reach};
 use crate::protocol::{SupervisorState, Target};
+
+/// The load at which a model whose load enters only through `mu W` (the Dahl steady state,
+/// [`FrictionModel::load_enters_as_coulomb_force`]) sees the measured Coulomb force: `W mu0 /
+/// mu`, with `mu0` the learned natural friction and `mu` the model's (the scene's prior).
+///
+/// Why: the Dahl steady state depends on `kappa x_a = k_t x_a / (mu W)`, the amplitude over the
+/// contact's elastic slip length `mu W / k_t`. That length is set by the real Coulomb force,
+/// which the controller measures (mu0, learned sliding with the drive off), not by the
+/// nominal `mu`. With the nominal value a plant whose mu is 20 % higher looks 20 % stiffer
+/// than it is, the inverse asks for too little amplitude and the PI has to find the whole
+/// difference. (k_t is not observable without vibration and stays nominal.)
+///
+/// `mu0 / mu` as a factor in Q33.30 (an `i64`; `mu0` and `mu` Q2.30, floored at
+/// [`MIN_NATURAL_COEF`] as the learner floors them, so the factor is in (2^19, 2^42)). Rounded
+/// to nearest. The controller keeps it while `mu0` and `mu` stay put: the division runs when
+/// they change (learning happens with the drive off), not in every step.
+pub(super) fn coulomb_factor(mu0: Q2_30, mu: Q2_30) -> i64 {
+    let num = (mu0.max(MIN_NATURAL_COEF).to_bits() as i64) << 30;
+    let den = mu.max(MIN_NATURAL_COEF).to_bits() as i64;
+    // num < 2^61, den in [2^20, 2^31): no overflow.
+    (num + den / 2) / den
+}
+
+/// `W mu0 / mu` for `load` Q16.16 N > 0 and `factor` = [`coulomb_factor`]`(mu0, mu)`, rounded
+/// to nearest (within 1.5 Q16.16 steps of the exact value: half a step of rounding, plus the
+/// factor's rounding, 2^-31, times W < 2^15 N). Error `OutOfDomain` if it does not
+/// fit Q16.16 (>= 32768 N): never saturated.
+pub(super) fn coulomb_load(load: Q16_16, factor: i64) -> Result<Q16_16, ModelError> {
+    let too_large = ModelError::OutOfDomain {
+        input: "W mu0 / mu",
+        reason: "the load at the learned natural friction exceeds Q16.16",
+    };
+    let product = (load.to_bits() as i64)
+        .checked_mul(factor)
+        .and_then(|p| p.checked_add(1 << 29))
+        .ok_or(too_large)?;
+    i32::try_from(product >> 30)
+        .map(Q16_16::from_bits)
+        .map_err(|_| too_large)
+}
 
 /// The controller's state (separate from its [`Config`]; never re-allocated).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -37,6 +77,8 @@ pub struct ControllerState {
     /// the next inversion starts ([`FrictionModel::invert_from`]); zero from each ramp-up.
     feedforward: Q1_31,
     target: Option<(Target, PreparedTarget)>,
+    /// The `mu0` and `mu` of the last [`coulomb_factor`], and the factor (Q33.30).
+    coulomb: (Q2_30, Q2_30, i64),
 }
 
 /// The friction controller: configuration plus state.
@@ -82,6 +124,7 @@ impl Controller {
                 prediction_valid: false,
                 feedforward: Q1_31::ZERO,
                 target: None,
+                coulomb: (Q2_30::ZERO, Q2_30::ZERO, 1 << 30),
             },
             config,
         }
@@ -215,8 +258,18 @@ impl Controller {
             report.saturation.integral_frozen = true;
             Q1_31::ZERO
         } else {
+            let load = estimate.normal_force.max(c.estimator.min_normal_force);
+            let normal_force = if model.load_enters_as_coulomb_force() {
+                let (mu0, mu) = (s.natural.coefficient(), c.natural.prior);
+                if (s.coulomb.0, s.coulomb.1) != (mu0, mu) {
+                    s.coulomb = (mu0, mu, coulomb_factor(mu0, mu));
+                }
+                coulomb_load(load, s.coulomb.2)?
+            } else {
+                load
+            };
             let point = OperatingPoint {
-                normal_force: estimate.normal_force.max(c.estimator.min_normal_force),
+                normal_force,
                 sliding_velocity: estimate.sliding_velocity.saturating_abs().value,
             };
             // The reference: what the model says the cells should read now, given the drive

@@ -412,3 +412,102 @@ fn each_inversion_starts_from_the_previous_one_and_a_restart_from_zero() {
     run(&mut ctl, &model, &mut plant, 200);
     check(&model.calls.borrow());
 }
+
+/// Records the load of every evaluation; declares (or not) that its load enters as `mu W`.
+struct LoadRecorder {
+    inner: LittmannModel,
+    coulomb_force: bool,
+    loads: core::cell::RefCell<Vec<f64>>,
+}
+
+impl FrictionModel for LoadRecorder {
+    fn ratio(&self, point: &OperatingPoint, amplitude: Q1_31) -> Result<Q2_30, ModelError> {
+        self.loads.borrow_mut().push(point.normal_force.to_f64());
+        self.inner.ratio(point, amplitude)
+    }
+
+    fn load_enters_as_coulomb_force(&self) -> bool {
+        self.coulomb_force
+    }
+}
+
+#[test]
+fn a_model_of_the_coulomb_force_sees_the_load_at_the_learned_natural_friction() {
+    // Prior mu 0.25, plant mu 0.3: the learned mu0 is 20 % above the model's mu.
+    let settings = Settings {
+        natural_prior: 0.25,
+        ..Settings::REFERENCE
+    };
+    let record = |coulomb_force| {
+        let mut ctl = Controller::new(Config::new(&settings).unwrap());
+        let mut plant = Plant::new(0.3, 0.0754 * 0.9, 0.8e-3, T, 3);
+        let model = LoadRecorder {
+            inner: LittmannModel::new(0.0754),
+            coulomb_force,
+            loads: core::cell::RefCell::new(Vec::new()),
+        };
+        ctl.set_target(HALF).unwrap();
+        run(&mut ctl, &model, &mut plant, 100);
+        ctl.start().unwrap();
+        run(&mut ctl, &model, &mut plant, 200);
+        let mu0 = ctl.natural_coefficient().to_f64();
+        (model.loads.into_inner(), mu0)
+    };
+    let (plain, mu0) = record(false);
+    let (scaled, mu0_again) = record(true);
+    // The Littmann law ignores the load, so both runs are the same run.
+    assert_eq!(mu0, mu0_again);
+    assert!((mu0 / 0.25 - 1.2).abs() < 0.02, "mu0 {mu0}");
+    assert_eq!(plain.len(), scaled.len());
+    assert!(plain.len() > 100, "{} evaluations", plain.len());
+    // mu0 is still learned in the first steps of the ramp (drive below natural_max_drive);
+    // compare once it has stopped moving.
+    for (w, w_model) in plain.iter().zip(&scaled).skip(plain.len() / 2) {
+        let expected = w * mu0 / 0.25;
+        // Q16.16 rounding of the scaled load, and mu0's rounding in Q2.30.
+        assert!(
+            (w_model - expected).abs() < 2.0 / 65536.0,
+            "{w_model} vs {expected}"
+        );
+    }
+}
+
+#[test]
+fn the_coulomb_load_is_exact_at_its_extremes_and_refuses_what_does_not_fit() {
+    use super::controller::{coulomb_factor, coulomb_load};
+    let coulomb_load = |w, mu0, mu| coulomb_load(w, coulomb_factor(mu0, mu));
+    use super::estimate::MIN_NATURAL_COEF;
+    let q16 = |x: f64| Q16_16::from_f64(x).unwrap();
+    let q30 = |x: f64| Q2_30::from_f64(x).unwrap();
+    for (w, mu0, mu) in [
+        (4.155, 0.24, 0.2),
+        (1.0 / 65536.0, 0.24, 0.2),
+        (0.01, 1.999, 1e-3),
+        (32767.0, 1e-3, 1.999),
+        (16000.0, 0.2, 0.1),
+        (1.0, 0.3, 0.3),
+    ] {
+        let got = coulomb_load(q16(w), q30(mu0), q30(mu)).unwrap().to_f64();
+        let exact = q16(w).to_f64() * q30(mu0).to_f64() / q30(mu).to_f64();
+        // Half a step of rounding, plus the factor's half-ULP (2^-31) times W < 2^15 N: one step.
+        assert!(
+            (got - exact).abs() <= 1.5 / 65536.0,
+            "{w} {mu0} {mu}: {got} vs {exact}"
+        );
+    }
+    // Equal coefficients: the load unchanged, bit for bit.
+    assert_eq!(
+        coulomb_load(q16(4.155), q30(0.2), q30(0.2)).unwrap(),
+        q16(4.155)
+    );
+    // Coefficients below the learner's floor count as the floor (never a division by zero).
+    assert_eq!(
+        coulomb_load(q16(2.0), Q2_30::ZERO, Q2_30::ZERO).unwrap(),
+        coulomb_load(q16(2.0), MIN_NATURAL_COEF, MIN_NATURAL_COEF).unwrap()
+    );
+    // W mu0 / mu >= 32768 N does not fit Q16.16: an error, not a saturated load.
+    assert!(matches!(
+        coulomb_load(q16(20000.0), q30(0.4), q30(0.2)),
+        Err(ModelError::OutOfDomain { .. })
+    ));
+}

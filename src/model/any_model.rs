@@ -191,6 +191,17 @@ impl FrictionModel for AnyModel {
             AnyModel::DahlTable(model) => model.invert_from(point, target, start),
         }
     }
+
+    fn load_enters_as_coulomb_force(&self) -> bool {
+        match self {
+            AnyModel::Coulomb(model) => model.load_enters_as_coulomb_force(),
+            AnyModel::ExpCoulomb(model) => model.load_enters_as_coulomb_force(),
+            AnyModel::Dahl(model) => model.load_enters_as_coulomb_force(),
+            AnyModel::Cube(model) => model.load_enters_as_coulomb_force(),
+            AnyModel::CubeTable(model) => model.load_enters_as_coulomb_force(),
+            AnyModel::DahlTable(model) => model.load_enters_as_coulomb_force(),
+        }
+    }
 }
 
 /// The scene kind of a cube model, from its contact.

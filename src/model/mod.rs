@@ -208,6 +208,16 @@ pub trait FrictionModel {
         let _ = start;
         self.invert(point, target)
     }
+
+    /// Whether the load enters the model only through the Coulomb force `F_c = mu W` with the
+    /// model's own `mu` (the Dahl steady state: `kappa x_a = k_t x_a / (mu W)`). For such a
+    /// model the controller passes the load scaled by `mu0 / mu` (learned natural friction
+    /// over the model's), so that the model sees the measured Coulomb force `mu0 W`. The
+    /// default, `false`, is right for models whose ratio does not depend on `mu` (the
+    /// Coulomb ratio depends on neither `mu` nor `W`; the cube's load is a normal contact's).
+    fn load_enters_as_coulomb_force(&self) -> bool {
+        false
+    }
 }
 
 /// Bisection steps of the default inversion: 2^-16 of full scale, finer than the drive's

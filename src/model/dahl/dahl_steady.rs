@@ -137,6 +137,11 @@ pub struct DahlSteadyState<const FW: u32> {
 }
 
 impl FrictionModel for DahlModel {
+    /// `kappa x_a = k_t x_a / (mu W)`: the load enters only through `mu W`.
+    fn load_enters_as_coulomb_force(&self) -> bool {
+        true
+    }
+
     /// Steady-state ratio at the operating point (W Q16.16, v Q8.24). Errors as
     /// [`DahlConstants::drive`]. Cost: see [`DahlModel::steady_ratio`]; the default bisection
     /// inverse calls it 18 times.

@@ -285,6 +285,11 @@ fn ln_q24(a: Scaled) -> Result<Q8_24, bool> {
 }
 
 impl FrictionModel for DahlTable {
+    /// `kappa x_a = k_t x_a / (mu W)`: the load enters only through `mu W`.
+    fn load_enters_as_coulomb_force(&self) -> bool {
+        true
+    }
+
     /// F'/F at the operating point (W Q16.16 > 0, v Q8.24) and `amplitude` (Q1.31 in [0, 1)):
     /// zeta and kappa x_a as the exact model forms them, x = mu_i(zeta), y = ln(kappa x_a), then
     /// the bicubic table. Exactly 1 without reversal (|zeta| >= 1 or no vibration), 0 at v = 0.
