@@ -44,9 +44,14 @@ mod tests {
     #[test]
     fn the_compiled_in_data_stays_small() {
         // Flash budget of the scene table (structs, not counting strings and tables), for
-        // the 32-bit target and the 64-bit host alike.
+        // the 32-bit target and the 64-bit host alike: under 1 KB per scene (936 B with the
+        // resonance shift of issue 14), so that the table grows with the scenes only.
         let bytes = core::mem::size_of_val(SCENES);
-        assert!(bytes < 12_000, "{bytes} bytes");
+        assert!(
+            bytes < 1_000 * SCENES.len(),
+            "{bytes} bytes for {}",
+            SCENES.len()
+        );
     }
 
     #[test]

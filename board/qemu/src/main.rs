@@ -161,7 +161,11 @@ async fn supervisor_task(args: Args, control_spawner: SendSpawner) {
             exit::exit(exit::SELFCHECK_FAILED);
         }
     };
-    let rig = Persisted::new(rig, store, booted, false, known_scene);
+    // The rig (the station, the simulated plant and the judge: about 25 KB) lives in a static,
+    // and the control task holds a reference: passed by value, its copies on the way into the
+    // task's future overflowed the 99 KB stack.
+    static RIG: StaticCell<Rig> = StaticCell::new();
+    let rig = RIG.init(Persisted::new(rig, store, booted, false, known_scene));
     match control_task(rig, args) {
         Ok(token) => {
             control_spawner.spawn(token);
@@ -174,7 +178,7 @@ async fn supervisor_task(args: Args, control_spawner: SendSpawner) {
 }
 
 #[embassy_executor::task]
-async fn control_task(mut rig: Rig, args: Args) {
+async fn control_task(rig: &'static mut Rig, args: Args) {
     let scene = rig.inner().scene();
     if args.serve {
         defmt::info!(
@@ -197,7 +201,7 @@ async fn control_task(mut rig: Rig, args: Args) {
         executor::idle_cycles(),
         time_driver::excluded_cycles(),
     );
-    let stats = failure::run(&mut rig, steps).await;
+    let stats = failure::run(rig, steps).await;
     let elapsed = time_driver::cycles().saturating_sub(start.0);
     let plant = time_driver::excluded_cycles().saturating_sub(start.2);
     let idle = executor::idle_cycles().saturating_sub(start.1);
