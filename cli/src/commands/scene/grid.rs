@@ -192,7 +192,7 @@ pub fn envelope_file(
     reduction_pct: f64,
 ) -> Option<String> {
     let name = format!(
-        "envelope-{}n-{}mms-{}pct",
+        "env-{}n-{}mms-{}pct",
         load_n,
         (speed * 1e3).round(),
         reduction_pct.round()
@@ -206,7 +206,7 @@ pub fn envelope_file(
             (
                 "description",
                 format!(
-                    "Envelope point: the reference rig at {load_n} N and {speed} m/s, friction reduced by {reduction_pct:.1} % at 5 ms."
+                    "\"Envelope point: the reference rig at {load_n} N and {speed} m/s, friction reduced by {reduction_pct:.1} % at 5 ms.\""
                 ),
             ),
         ],
@@ -332,7 +332,7 @@ mod tests {
         let loaded = load_text(&file, "envelope.toml").expect("a valid scene");
         let s = loaded.scene();
         let reference = find("reference").expect("built in");
-        assert_eq!(s.name, "envelope-0p5n-80mms-21pct");
+        assert_eq!(s.name, "env-0p5n-80mms-21pct");
         assert_eq!(s.normal_load_n[0].value, 0.5);
         assert_eq!(s.sliding_velocity_m_per_s[0].value, 0.08);
         assert_eq!(s.contents.load_max_n, 0.5);
