@@ -17,15 +17,15 @@ pub static MEASURED: Measurements = Measurements {
 static COSTS: &[Cost] = &[
     Cost {
         variant: "Littmann closed form",
-        instructions: 42.106,
+        instructions: 42.182,
     },
     Cost {
         variant: "Littmann closed form f32 micromath",
-        instructions: 30.866,
+        instructions: 30.885,
     },
     Cost {
         variant: "Littmann closed form f32 libm",
-        instructions: 414.782,
+        instructions: 414.858,
     },
     Cost {
         variant: "Littmann closed form f64",
@@ -37,7 +37,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl update f32 micromath",
-        instructions: 107.213,
+        instructions: 107.247,
     },
     Cost {
         variant: "Dahl update f32 libm",
@@ -49,47 +49,47 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 315.294,
+        instructions: 315.196,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 68.627,
+        instructions: 68.872,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 259.215,
+        instructions: 259.166,
     },
     Cost {
         variant: "Coulomb ratio f64",
-        instructions: 2719.95,
+        instructions: 2720.049,
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11353.494,
+        instructions: 11353.279,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 5869.301,
+        instructions: 5869.731,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 31789.516,
+        instructions: 31789.838,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 147229.19,
+        instructions: 147230.22,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20281.129,
+        instructions: 20281.182,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
-        instructions: 11294.784,
+        instructions: 11294.838,
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 58560.97,
+        instructions: 58561.29,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
@@ -97,7 +97,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 37995.86,
+        instructions: 37995.97,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
@@ -109,11 +109,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 511143.0,
+        instructions: 511146.56,
     },
     Cost {
         variant: "Dahl steady T=33x33",
-        instructions: 910.645,
+        instructions: 910.698,
     },
     Cost {
         variant: "Dahl steady T=65x65",
@@ -121,7 +121,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 591.969,
+        instructions: 591.818,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
@@ -129,11 +129,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 260.303,
+        instructions: 260.454,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9423.333,
+        instructions: 9423.484,
     },
     Cost {
         variant: "cube el N=8",
@@ -145,35 +145,35 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8 f32 libm",
-        instructions: 388.181,
+        instructions: 388.333,
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15228.636,
+        instructions: 15229.09,
     },
     Cost {
         variant: "cube el N=16",
-        instructions: 1305.757,
+        instructions: 1306.06,
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
-        instructions: 1141.818,
+        instructions: 1141.969,
     },
     Cost {
         variant: "cube el N=16 f32 libm",
-        instructions: 646.969,
+        instructions: 647.272,
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26879.545,
+        instructions: 26879.848,
     },
     Cost {
         variant: "cube el N=32",
-        instructions: 2257.727,
+        instructions: 2258.03,
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.666,
+        instructions: 2161.363,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
@@ -181,7 +181,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50122.88,
+        instructions: 50123.18,
     },
     Cost {
         variant: "cube el T=5x5",
@@ -193,7 +193,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el T=17x17",
-        instructions: 282.575,
+        instructions: 282.727,
     },
     Cost {
         variant: "cube ep N=4",
@@ -201,11 +201,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 377.878,
+        instructions: 378.181,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
-        instructions: 260.606,
+        instructions: 260.303,
     },
     Cost {
         variant: "cube ep N=4 f64",
@@ -213,7 +213,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 829.696,
+        instructions: 830.0,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
@@ -225,15 +225,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=8 f64",
-        instructions: 15216.363,
+        instructions: 15216.212,
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1305.909,
+        instructions: 1305.757,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
-        instructions: 1141.818,
+        instructions: 1141.666,
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
@@ -241,7 +241,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26867.879,
+        instructions: 26868.182,
     },
     Cost {
         variant: "cube ep N=32",
@@ -249,23 +249,23 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
-        instructions: 2161.515,
+        instructions: 2161.666,
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
-        instructions: 1162.727,
+        instructions: 1162.878,
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50111.21,
+        instructions: 50111.06,
     },
     Cost {
         variant: "cube ep T=5x5",
-        instructions: 282.727,
+        instructions: 282.878,
     },
     Cost {
         variant: "cube ep T=9x9",
-        instructions: 282.424,
+        instructions: 283.03,
     },
     Cost {
         variant: "cube ep T=17x17",
