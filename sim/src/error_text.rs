@@ -1,5 +1,5 @@
 //! Words for why a scene cannot run (`Display` of [`SimError`] and [`PlantError`]). The host's
-//! `sonolube scene` adds which scene value led there (`host-tests/src/cli/scene/why.rs`).
+//! `sonolube scene` adds which scene value led there (`cli/src/commands/scene/why.rs`).
 
 use core::fmt;
 
