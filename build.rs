@@ -5,6 +5,11 @@
 //! loader uses) and written as Rust `static` data of the `no_std` `sonolube::scene::Scene`
 //! type to `$OUT_DIR/scenes.rs`, which `src/scene/builtin.rs` includes. A scene that does not
 //! validate fails the build with its file, key and reason.
+//!
+//! A build without a model family (the cargo features `dahl`, `cube`, `exp-coulomb`) compiles
+//! in only the scenes whose controller model is in the build and whose hardware needs no
+//! left-out family (a horn vibrates the contact normally: the cube family). The plant model is
+//! the simulation's (`sonolube-sim`, which takes every family); a board drives a real contact.
 
 use std::path::PathBuf;
 
@@ -17,11 +22,30 @@ fn main() {
     for file in &files {
         println!("cargo::rerun-if-changed={}", file.display());
     }
-    let scenes = scene_toml::load_dir(&scenes_dir).unwrap_or_else(|error| fail(&error));
+    let mut scenes = scene_toml::load_dir(&scenes_dir).unwrap_or_else(|error| fail(&error));
+    scenes.retain(|scene| {
+        in_build(scene.controller.kind) && (scene.horn.is_none() || feature("CUBE"))
+    });
     let out_dir = PathBuf::from(std::env::var_os("OUT_DIR").unwrap_or_default());
     let out = out_dir.join("scenes.rs");
     if let Err(error) = std::fs::write(&out, scene_toml::generate_rust(&scenes)) {
         fail(&format!("cannot write {}: {error}", out.display()));
+    }
+}
+
+/// Whether the crate is built with the cargo feature `name` (upper case, `-` as `_`).
+fn feature(name: &str) -> bool {
+    std::env::var_os(format!("CARGO_FEATURE_{name}")).is_some()
+}
+
+/// Whether the model family of `kind` is in this build (`ModelKind::in_build` of the crate).
+fn in_build(kind: scene_toml::ModelKind) -> bool {
+    use scene_toml::ModelKind;
+    match kind {
+        ModelKind::Coulomb => true,
+        ModelKind::ExpCoulomb => feature("EXP_COULOMB"),
+        ModelKind::Dahl => feature("DAHL"),
+        ModelKind::CubeElastic | ModelKind::CubeElasticPlastic => feature("CUBE"),
     }
 }
 

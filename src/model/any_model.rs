@@ -6,16 +6,27 @@
 //! controller can build one from the controller spec the same way.
 
 use crate::fx::{Q1_31, Q2_30};
-use crate::model::contact::{ContactKind, ContactParams, EStarRule};
+use crate::model::contact::ContactParams;
+#[cfg(feature = "cube")]
+use crate::model::contact::{ContactKind, EStarRule};
 use crate::model::coulomb::{CoulombConstants, CoulombModel};
+#[cfg(feature = "cube")]
 use crate::model::cube::{CubeOptions, CubeParams};
+#[cfg(feature = "cube")]
 use crate::model::cube_model::CubeModel;
+#[cfg(feature = "cube")]
 use crate::model::cube_table::CubeTable;
+#[cfg(feature = "dahl")]
 use crate::model::dahl::DahlParams;
+#[cfg(feature = "dahl")]
 use crate::model::dahl_steady::DahlModel;
+#[cfg(feature = "dahl")]
 use crate::model::dahl_table::DahlTable;
+#[cfg(feature = "exp-coulomb")]
 use crate::model::exp_average::ExpCoulombVibrated;
+#[cfg(feature = "cube")]
 use crate::model::horn::UPhase;
+#[cfg(feature = "cube")]
 use crate::model::quadrature::SlipWindow;
 use crate::model::{FrictionModel, Inversion, ModelError, OperatingPoint};
 use crate::scene::{ModelKind, ModelSpec, RoughSurface, Scene};
@@ -69,18 +80,23 @@ pub enum AnyModel {
     /// Littmann law on a Coulomb contact ([`ModelKind::Coulomb`]).
     Coulomb(CoulombModel),
     /// Exponential Coulomb law averaged over the vibration ([`ModelKind::ExpCoulomb`]).
+    #[cfg(feature = "exp-coulomb")]
     ExpCoulomb(ExpCoulombVibrated),
     /// Dahl contact in its periodic steady state ([`ModelKind::Dahl`]).
+    #[cfg(feature = "dahl")]
     Dahl(DahlModel),
     /// Cube model, elastic or elastic-plastic contact ([`ModelKind::CubeElastic`],
     /// [`ModelKind::CubeElasticPlastic`]).
+    #[cfg(feature = "cube")]
     Cube(CubeModel),
     /// Cube model tabulated over (ln load, amplitude) and interpolated, with its exact model for
     /// loads outside the table (a model variant only: no scene kind names it;
     /// `crate::variant::select` chooses it).
+    #[cfg(feature = "cube")]
     CubeTable(CubeTable),
     /// Dahl steady state interpolated in a table compiled into flash (a model variant only,
     /// chosen by `crate::variant::select`; [`crate::model::dahl_table`]).
+    #[cfg(feature = "dahl")]
     DahlTable(DahlTable),
 }
 
@@ -99,12 +115,14 @@ impl AnyModel {
             ModelKind::Coulomb => Ok(AnyModel::Coulomb(CoulombModel {
                 constants: CoulombConstants::new(spec.mu, frequency_hz, amplitude_m)?,
             })),
+            #[cfg(feature = "exp-coulomb")]
             ModelKind::ExpCoulomb => Ok(AnyModel::ExpCoulomb(ExpCoulombVibrated::new(
                 spec.mu_static.ok_or(missing("mu_s"))?,
                 spec.mu,
                 spec.decay_s_per_m.ok_or(missing("alpha_dc"))?,
                 core::f64::consts::TAU * frequency_hz * amplitude_m,
             )?)),
+            #[cfg(feature = "dahl")]
             ModelKind::Dahl => Ok(AnyModel::Dahl(DahlModel::new(&DahlParams {
                 friction_coefficient: spec.mu,
                 tangential_stiffness: spec.k_t_n_per_m.ok_or(missing("k_t"))?,
@@ -113,6 +131,7 @@ impl AnyModel {
                 shape_exponent: spec.dahl_alpha.unwrap_or(1.0),
                 quadrature_points: DAHL_QUADRATURE_POINTS,
             })?)),
+            #[cfg(feature = "cube")]
             ModelKind::CubeElastic | ModelKind::CubeElasticPlastic => {
                 let horn = scene.horn.ok_or(missing("horn"))?;
                 let surface = spec.surface.ok_or(missing("surface"))?;
@@ -138,6 +157,8 @@ impl AnyModel {
                 };
                 Ok(AnyModel::Cube(CubeModel::new(&params, &options)?))
             }
+            #[allow(unreachable_patterns)]
+            kind => Err(not_compiled(kind)),
         }
     }
 
@@ -145,9 +166,13 @@ impl AnyModel {
     pub fn kind(&self) -> ModelKind {
         match self {
             AnyModel::Coulomb(_) => ModelKind::Coulomb,
+            #[cfg(feature = "exp-coulomb")]
             AnyModel::ExpCoulomb(_) => ModelKind::ExpCoulomb,
+            #[cfg(feature = "dahl")]
             AnyModel::Dahl(_) | AnyModel::DahlTable(_) => ModelKind::Dahl,
+            #[cfg(feature = "cube")]
             AnyModel::Cube(model) => cube_kind(model),
+            #[cfg(feature = "cube")]
             AnyModel::CubeTable(table) => cube_kind(table.exact()),
         }
     }
@@ -157,10 +182,15 @@ impl FrictionModel for AnyModel {
     fn ratio(&self, point: &OperatingPoint, amplitude: Q1_31) -> Result<Q2_30, ModelError> {
         match self {
             AnyModel::Coulomb(model) => model.ratio(point, amplitude),
+            #[cfg(feature = "exp-coulomb")]
             AnyModel::ExpCoulomb(model) => model.ratio(point, amplitude),
+            #[cfg(feature = "dahl")]
             AnyModel::Dahl(model) => model.ratio(point, amplitude),
+            #[cfg(feature = "cube")]
             AnyModel::Cube(model) => model.ratio(point, amplitude),
+            #[cfg(feature = "cube")]
             AnyModel::CubeTable(model) => model.ratio(point, amplitude),
+            #[cfg(feature = "dahl")]
             AnyModel::DahlTable(model) => model.ratio(point, amplitude),
         }
     }
@@ -168,10 +198,15 @@ impl FrictionModel for AnyModel {
     fn invert(&self, point: &OperatingPoint, target: Q2_30) -> Result<Inversion, ModelError> {
         match self {
             AnyModel::Coulomb(model) => model.invert(point, target),
+            #[cfg(feature = "exp-coulomb")]
             AnyModel::ExpCoulomb(model) => model.invert(point, target),
+            #[cfg(feature = "dahl")]
             AnyModel::Dahl(model) => model.invert(point, target),
+            #[cfg(feature = "cube")]
             AnyModel::Cube(model) => model.invert(point, target),
+            #[cfg(feature = "cube")]
             AnyModel::CubeTable(model) => model.invert(point, target),
+            #[cfg(feature = "dahl")]
             AnyModel::DahlTable(model) => model.invert(point, target),
         }
     }
@@ -184,10 +219,15 @@ impl FrictionModel for AnyModel {
     ) -> Result<Inversion, ModelError> {
         match self {
             AnyModel::Coulomb(model) => model.invert_from(point, target, start),
+            #[cfg(feature = "exp-coulomb")]
             AnyModel::ExpCoulomb(model) => model.invert_from(point, target, start),
+            #[cfg(feature = "dahl")]
             AnyModel::Dahl(model) => model.invert_from(point, target, start),
+            #[cfg(feature = "cube")]
             AnyModel::Cube(model) => model.invert_from(point, target, start),
+            #[cfg(feature = "cube")]
             AnyModel::CubeTable(model) => model.invert_from(point, target, start),
+            #[cfg(feature = "dahl")]
             AnyModel::DahlTable(model) => model.invert_from(point, target, start),
         }
     }
@@ -195,16 +235,22 @@ impl FrictionModel for AnyModel {
     fn load_enters_as_coulomb_force(&self) -> bool {
         match self {
             AnyModel::Coulomb(model) => model.load_enters_as_coulomb_force(),
+            #[cfg(feature = "exp-coulomb")]
             AnyModel::ExpCoulomb(model) => model.load_enters_as_coulomb_force(),
+            #[cfg(feature = "dahl")]
             AnyModel::Dahl(model) => model.load_enters_as_coulomb_force(),
+            #[cfg(feature = "cube")]
             AnyModel::Cube(model) => model.load_enters_as_coulomb_force(),
+            #[cfg(feature = "cube")]
             AnyModel::CubeTable(model) => model.load_enters_as_coulomb_force(),
+            #[cfg(feature = "dahl")]
             AnyModel::DahlTable(model) => model.load_enters_as_coulomb_force(),
         }
     }
 }
 
 /// The scene kind of a cube model, from its contact.
+#[cfg(feature = "cube")]
 fn cube_kind(model: &CubeModel) -> ModelKind {
     match model.scene().contact().scene().kind {
         ContactKind::Elastic => ModelKind::CubeElastic,
@@ -212,6 +258,25 @@ fn cube_kind(model: &CubeModel) -> ModelKind {
     }
 }
 
+/// The error for a model whose family this build leaves out (the cargo features `dahl`,
+/// `cube` and `exp-coulomb` of the core; the built-in scenes of such a build never name one).
+pub fn not_compiled(kind: ModelKind) -> ModelError {
+    ModelError::OutOfDomain {
+        input: "model",
+        reason: match kind {
+            ModelKind::Dahl => "the Dahl family is not in this build (cargo feature `dahl`)",
+            ModelKind::ExpCoulomb => {
+                "the exponential Coulomb law is not in this build (cargo feature `exp-coulomb`)"
+            }
+            ModelKind::CubeElastic | ModelKind::CubeElasticPlastic => {
+                "the cube family is not in this build (cargo feature `cube`)"
+            }
+            ModelKind::Coulomb => "the Coulomb model is in every build",
+        },
+    }
+}
+
+#[cfg(any(feature = "dahl", feature = "cube", feature = "exp-coulomb"))]
 fn missing(input: &'static str) -> ModelError {
     ModelError::OutOfDomain {
         input,
@@ -289,6 +354,7 @@ mod tests {
     }
 
     /// What a plant or controller holds by value: the table's fixed capacity is the bulk.
+    #[cfg(feature = "cube")]
     #[test]
     fn size() {
         let size = core::mem::size_of::<AnyModel>();

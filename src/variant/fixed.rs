@@ -14,17 +14,26 @@ use super::{Fidelity, Variant};
 use crate::model::AnyModel;
 use crate::model::ModelError;
 use crate::model::any_model::contact_params;
-use crate::model::contact::{ContactKind, EStarRule};
+use crate::model::contact::ContactKind;
+#[cfg(feature = "cube")]
+use crate::model::contact::EStarRule;
 use crate::model::coulomb::{CoulombConstants, CoulombModel};
+#[cfg(feature = "cube")]
 use crate::model::cube::{CubeOptions, CubeParams};
+#[cfg(feature = "cube")]
 use crate::model::cube_model::CubeModel;
+#[cfg(feature = "cube")]
 use crate::model::cube_table::CubeTable;
 use crate::model::dahl::DahlParams;
+#[cfg(feature = "dahl")]
 use crate::model::dahl_steady::DahlModel;
+#[cfg(feature = "dahl")]
 use crate::model::dahl_table::{DahlGrid, DahlTable};
+#[cfg(feature = "cube")]
 use crate::model::horn::UPhase;
+#[cfg(feature = "cube")]
 use crate::model::quadrature::SlipWindow;
-use crate::scene::Scene;
+use crate::scene::{ModelKind, Scene};
 
 /// What a scene's controller spec lacks for a fidelity level.
 fn missing(input: &'static str) -> ModelError {
@@ -35,24 +44,32 @@ fn missing(input: &'static str) -> ModelError {
 }
 
 /// Whether the scene's controller spec and hardware carry every parameter of `fidelity`
-/// (kernels need none).
+/// (kernels need none), and this build holds the level's model family
+/// ([`ModelKind::in_build`]).
 pub fn buildable(scene: &Scene<'_>, fidelity: Fidelity) -> bool {
     match fidelity {
         Fidelity::Littmann | Fidelity::DahlUpdate | Fidelity::Coulomb => true,
-        Fidelity::DahlSteady => scene.controller.k_t_n_per_m.is_some(),
+        Fidelity::DahlSteady => {
+            ModelKind::Dahl.in_build() && scene.controller.k_t_n_per_m.is_some()
+        }
         Fidelity::CubeElastic | Fidelity::CubeElasticPlastic => {
-            scene.horn.is_some() && scene.controller.surface.is_some()
+            ModelKind::CubeElasticPlastic.in_build()
+                && scene.horn.is_some()
+                && scene.controller.surface.is_some()
         }
     }
 }
 
 /// Whether `variant` can be built for `scene`: [`buildable`] for its level, and for a Dahl
-/// table alpha = 1 (the tables in flash are for alpha = 1 only).
+/// table alpha = 1 (the tables in flash are for alpha = 1 only) and a table of that size in
+/// this build ([`crate::model::dahl_table::DahlGrid::of_side`]).
 pub fn variant_buildable(scene: &Scene<'_>, variant: &Variant) -> bool {
+    let dahl_table = variant.fidelity == Fidelity::DahlSteady && variant.table > 0;
     buildable(scene, variant.fidelity)
-        && !(variant.fidelity == Fidelity::DahlSteady
-            && variant.table > 0
-            && scene.controller.dahl_alpha.unwrap_or(1.0) != 1.0)
+        && !(dahl_table
+            && (scene.controller.dahl_alpha.unwrap_or(1.0) != 1.0
+                || crate::model::dahl_table::DahlGrid::of_side(usize::from(variant.table))
+                    .is_none()))
 }
 
 /// Dahl parameters of the scene's controller at `points` nodes per period.
@@ -112,6 +129,7 @@ pub fn fixed_model(scene: &Scene<'_>, variant: &Variant) -> Result<AnyModel, Mod
         Fidelity::Coulomb => Ok(AnyModel::Coulomb(CoulombModel {
             constants: CoulombConstants::new(scene.controller.mu, frequency_hz, amplitude_m)?,
         })),
+        #[cfg(feature = "dahl")]
         Fidelity::DahlSteady if variant.table > 0 => {
             let grid =
                 DahlGrid::of_side(usize::from(variant.table)).ok_or(ModelError::OutOfDomain {
@@ -123,10 +141,18 @@ pub fn fixed_model(scene: &Scene<'_>, variant: &Variant) -> Result<AnyModel, Mod
                 grid,
             )?))
         }
+        #[cfg(feature = "dahl")]
         Fidelity::DahlSteady => Ok(AnyModel::Dahl(DahlModel::new(&dahl_params(
             scene,
             u32::from(variant.points),
         )?)?)),
+        #[cfg(not(feature = "dahl"))]
+        Fidelity::DahlSteady => Err(crate::model::any_model::not_compiled(ModelKind::Dahl)),
+        #[cfg(not(feature = "cube"))]
+        Fidelity::CubeElastic | Fidelity::CubeElasticPlastic => Err(
+            crate::model::any_model::not_compiled(ModelKind::CubeElasticPlastic),
+        ),
+        #[cfg(feature = "cube")]
         Fidelity::CubeElastic | Fidelity::CubeElasticPlastic => {
             let p = cube_params(scene, variant.fidelity, usize::from(variant.points))?;
             let params = CubeParams {

@@ -121,6 +121,7 @@ fn elastic_contact_beyond_budget_keeps_the_plastic_terms() {
 }
 
 #[test]
+#[cfg(feature = "cube")]
 fn table_sizes_within_the_count_resolution_tie_and_the_more_accurate_wins() {
     // The table sizes cost the same per evaluation up to the SysTick rounding: 5 x 5 misses
     // the 0.5 % budget, 9 x 9 and 17 x 17 meet it 0.3 instructions apart; the elastic table

@@ -72,11 +72,12 @@ pub static GRID_65: DahlGrid = DahlGrid {
 };
 
 impl DahlGrid {
-    /// The grid with `side` nodes per axis (33 or 65).
+    /// The grid with `side` nodes per axis (33 or 65; 65 only in a build with the cargo
+    /// feature `dahl-fine-table`, which the built-in scenes never select).
     pub fn of_side(side: usize) -> Option<&'static DahlGrid> {
         match side {
             33 => Some(&GRID_33),
-            65 => Some(&GRID_65),
+            65 if cfg!(feature = "dahl-fine-table") => Some(&GRID_65),
             _ => None,
         }
     }
