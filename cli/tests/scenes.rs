@@ -2,6 +2,7 @@
 //! build script compiled in (field by field), and satisfies its own invariants; broken files
 //! are refused with their file, key and reason.
 
+use sonolube::protocol::TargetRange;
 use std::path::PathBuf;
 
 use sonolube::protocol::{Target, is_scene_name};

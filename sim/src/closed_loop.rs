@@ -27,7 +27,7 @@ use sonolube::control::{
 };
 use sonolube::fx::Q1_31;
 use sonolube::model::AnyModel;
-use sonolube::protocol::{Axis, Command, ProtocolError, SupervisorState, Target};
+use sonolube::protocol::{Axis, Command, ProtocolError, SupervisorState, Target, TargetRange};
 use sonolube::scene::{Breakpoint, Scene};
 use sonolube::station::{CellBench, Sample, Station};
 

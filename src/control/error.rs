@@ -7,7 +7,7 @@
 use heapless::String;
 
 use super::reason::Reason;
-use crate::protocol::{ErrorCode, ProtocolError, SupervisorState, Target, TokenText};
+use crate::protocol::{ErrorCode, ProtocolError, SupervisorState, Target, TargetRange, TokenText};
 
 /// Why a command was refused. The controller's state is unchanged by a refused command.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -58,7 +58,7 @@ impl ControlError {
             ControlError::InvalidTarget { target } => {
                 let mut value: String<24> = String::new();
                 // 24 bytes hold every u32 with its decimals; on failure the quote is empty.
-                let _ = target.write_value(&mut value);
+                let _ = crate::protocol::write_target_value(&target, &mut value);
                 ProtocolError::OutOfRange {
                     token: TokenText::new(value.as_str()),
                     quantity: target.quantity(),

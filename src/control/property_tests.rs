@@ -10,7 +10,7 @@ use super::reason::{ExternalFault, Sensor, SensorFault, SensorFaultKind};
 use super::schedule::GainSchedule;
 use super::testkit::{LinearModel, LittmannModel};
 use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
-use crate::protocol::{SupervisorState as S, Target};
+use crate::protocol::{SupervisorState as S, Target, TargetRange};
 
 const T: f64 = 1e-4;
 

@@ -13,7 +13,7 @@
 
 use super::recip::Reciprocal;
 use crate::fx::{Q, Q2_30, Q16_16, Sat};
-use crate::protocol::Target;
+use crate::protocol::{Target, TargetRange};
 
 /// Force targets are kept in newtons as Q18.14: up to 131072 N (the protocol allows 50 kN),
 /// resolution 6.1e-5 N (the protocol's is 1 mN).

@@ -162,7 +162,7 @@ pub fn format_command(command: &Command, out: &mut StringView) -> Result<(), For
                 put(out, " ")?;
                 put(out, target.kind())?;
                 put(out, " ")?;
-                target.write_value(out)?;
+                super::target::write_value(target, out)?;
             }
             Command::SceneList => put(out, " list")?,
             Command::Scene(name) => {

@@ -188,7 +188,8 @@ pub use report::{
     format_status, format_version,
 };
 pub use state::SupervisorState;
-pub use target::{NO_TARGET, Target, TargetDecodeError, decode_target};
+pub(crate) use target::write_value as write_target_value;
+pub use target::{NO_TARGET, Target, TargetDecodeError, TargetRange, decode_target};
 pub use telemetry::{
     TELEMETRY_CAPACITY, TELEMETRY_TAG, TelemetryRecord, format_telemetry, parse_telemetry,
 };

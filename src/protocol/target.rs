@@ -10,44 +10,25 @@ use super::number::{NumberError, decode_u32};
 use super::quantity::{Quantity, TARGET_COEF, TARGET_FORCE, TARGET_REDUCTION};
 use super::text::{FormatError, put, put_fixed};
 
-/// A friction target. Ranges are those of the `target` command (see [`Quantity`]); the
-/// telemetry decoder accepts any `u32` so that it never rejects what the firmware printed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Target {
-    /// Hold the friction force (tangential force while sliding).
-    Force {
-        /// Friction force in mN, `1..=50_000_000` (0.001 N to 50 kN).
-        force_mn: u32,
-    },
-    /// Hold the friction coefficient (friction force over normal force).
-    Coef {
-        /// Coefficient in ppm (1e-6), `1..=2_000_000` (0.000001 to 2).
-        coef_ppm: u32,
-    },
-    /// Hold a reduction of the natural (undriven) friction.
-    Reduction {
-        /// Reduction in milli-percent, `0..=99_999` (0 % to 99.999 %).
-        reduction_mpct: u32,
-    },
-}
+/// The friction target (defined with the scene types, `sonolube-scene-types`, which the scene
+/// files share; its wire ranges are the protocol's: [`TargetRange`]).
+pub use sonolube_scene_types::Target;
 
 /// Text of an absent target in replies and telemetry.
 pub const NO_TARGET: &str = "none";
 
-impl Target {
-    /// The kind as written on the wire and in the `target` command: `force`, `coef` or
-    /// `reduction`.
-    pub const fn kind(&self) -> &'static str {
-        match self {
-            Target::Force { .. } => "force",
-            Target::Coef { .. } => "coef",
-            Target::Reduction { .. } => "reduction",
-        }
-    }
-
+/// What the protocol adds to a [`Target`]: its quantity (unit, resolution, the `target`
+/// command's range) and its written value.
+pub trait TargetRange {
     /// The quantity (unit, resolution, command range) of this kind of target.
-    pub const fn quantity(&self) -> &'static Quantity {
+    fn quantity(&self) -> &'static Quantity;
+
+    /// Whether the value is inside the range the `target` command accepts.
+    fn is_valid(&self) -> bool;
+}
+
+impl TargetRange for Target {
+    fn quantity(&self) -> &'static Quantity {
         match self {
             Target::Force { .. } => &TARGET_FORCE,
             Target::Coef { .. } => &TARGET_COEF,
@@ -55,44 +36,18 @@ impl Target {
         }
     }
 
-    /// The scaled value: mN, ppm or milli-percent depending on the kind.
-    pub const fn scaled_value(&self) -> u32 {
-        match *self {
-            Target::Force { force_mn } => force_mn,
-            Target::Coef { coef_ppm } => coef_ppm,
-            Target::Reduction { reduction_mpct } => reduction_mpct,
-        }
-    }
-
-    /// The target of kind `kind` (as returned by [`kind`](Self::kind)) with a scaled value.
-    pub fn from_kind(kind: &str, scaled_value: u32) -> Option<Self> {
-        match kind {
-            "force" => Some(Target::Force {
-                force_mn: scaled_value,
-            }),
-            "coef" => Some(Target::Coef {
-                coef_ppm: scaled_value,
-            }),
-            "reduction" => Some(Target::Reduction {
-                reduction_mpct: scaled_value,
-            }),
-            _ => None,
-        }
-    }
-
-    /// Whether the value is inside the range the `target` command accepts.
-    pub fn is_valid(&self) -> bool {
+    fn is_valid(&self) -> bool {
         self.quantity().contains(i64::from(self.scaled_value()))
     }
+}
 
-    /// Appends the value alone with all its decimals: `12.500`.
-    pub(crate) fn write_value(&self, out: &mut StringView) -> Result<(), FormatError> {
-        put_fixed(
-            out,
-            i64::from(self.scaled_value()),
-            self.quantity().decimals,
-        )
-    }
+/// Appends the value alone with all its decimals: `12.500`.
+pub(crate) fn write_value(target: &Target, out: &mut StringView) -> Result<(), FormatError> {
+    put_fixed(
+        out,
+        i64::from(target.scaled_value()),
+        target.quantity().decimals,
+    )
 }
 
 /// Appends `kind:value`, or [`NO_TARGET`].
@@ -105,7 +60,7 @@ pub(crate) fn write_target(
         Some(target) => {
             put(out, target.kind())?;
             put(out, ":")?;
-            target.write_value(out)
+            write_value(target, out)
         }
     }
 }

@@ -24,6 +24,7 @@ pub fn find(name: &str) -> Option<&'static Scene<'static>> {
 mod tests {
     use super::*;
     use crate::protocol::is_scene_name;
+    use crate::scene::in_build;
 
     #[test]
     fn every_scene_is_found_by_its_valid_unique_name() {
@@ -76,18 +77,11 @@ mod tests {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
         let files = scene_toml::load_dir(&dir).expect("the scene files load");
         assert!(files.len() >= 10, "{}", files.len());
-        let kind = |kind: scene_toml::ModelKind| match kind {
-            scene_toml::ModelKind::Coulomb => ModelKind::Coulomb,
-            scene_toml::ModelKind::ExpCoulomb => ModelKind::ExpCoulomb,
-            scene_toml::ModelKind::Dahl => ModelKind::Dahl,
-            scene_toml::ModelKind::CubeElastic => ModelKind::CubeElastic,
-            scene_toml::ModelKind::CubeElasticPlastic => ModelKind::CubeElasticPlastic,
-        };
         let mut expected: Vec<&str> = files
             .iter()
             .filter(|file| {
-                kind(file.controller.kind).in_build()
-                    && (file.horn.is_none() || ModelKind::CubeElasticPlastic.in_build())
+                in_build(file.controller.kind)
+                    && (file.horn.is_none() || in_build(ModelKind::CubeElasticPlastic))
             })
             .map(|file| file.name.as_str())
             .collect();
@@ -96,7 +90,7 @@ mod tests {
         built.sort_unstable();
         assert_eq!(built, expected);
         for scene in SCENES {
-            assert!(scene.controller.kind.in_build(), "{}", scene.name);
+            assert!(in_build(scene.controller.kind), "{}", scene.name);
         }
     }
 }

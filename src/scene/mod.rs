@@ -20,34 +20,29 @@
 //! of the profiles ([`interpolate`], [`target_at`]) is in `f32`, the plant's format.
 
 pub mod builtin;
-mod criteria;
-mod fault;
-mod hardware;
-mod spec;
 mod table;
 
 pub use builtin::{SCENES, find};
-pub use criteria::{Accuracy, Contents, Criterion};
-pub use fault::{Channel, FaultEvent, FaultKind, Rail};
-pub use hardware::{Actuator, ActuatorKind, Horn, LoadCell, ResonanceShift, Stack, Transducer};
-pub use spec::{Mismatch, ModelKind, ModelSpec, RoughSurface};
-pub use table::{Breakpoint, TargetPoint, interpolate, target_at};
+// The plain scene types, defined once in `sonolube-scene-types` and shared with the scene-file
+// loader (`scene-toml`), which reads them on the host and writes them for the build script.
+pub use sonolube_scene_types::{
+    Accuracy, Actuator, ActuatorKind, Breakpoint, Channel, Contents, Criterion, FaultEvent,
+    FaultKind, Horn, LoadCell, Mismatch, ModelKind, ModelSpec, Rail, ResonanceShift, RoughSurface,
+    Stack, System, TargetPoint, Transducer,
+};
+pub use table::{interpolate, target_at};
 
-/// Which system of the source papers a scene belongs to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum System {
-    /// Seed 003: PMN-PT stack transducer sliding on an aluminium guide rail, 40 kHz, 0-10 N
-    /// added load.
-    StackOnRail,
-    /// Seeds 000/001: Poisson-effect horn (waveguide) over a sliding block, 20 kHz, 40-240 N.
-    PoissonHorn,
-    /// Seed 002: flexible beam on a moving table (stick-slip rig), exponential Coulomb law,
-    /// with an ultrasonic actuator added at the beam tip.
-    BeamOnTable,
-    /// Application: seat-belt webbing sliding over a vibrated D-ring (seed 003 names seat-belt
-    /// systems as its future work).
-    SeatBelt,
+/// Whether this build holds the model family of `kind`: Coulomb always; the others with the
+/// core's cargo features `exp-coulomb`, `dahl` and `cube` (all on by default). The build script
+/// compiles in only the scenes whose controller model is in the build (and no horn scene
+/// without the cube family).
+pub const fn in_build(kind: ModelKind) -> bool {
+    match kind {
+        ModelKind::Coulomb => true,
+        ModelKind::ExpCoulomb => cfg!(feature = "exp-coulomb"),
+        ModelKind::Dahl => cfg!(feature = "dahl"),
+        ModelKind::CubeElastic | ModelKind::CubeElasticPlastic => cfg!(feature = "cube"),
+    }
 }
 
 /// A named operating scenario. Field units are in the names (`_hz`, `_s`, `_n`, `_m_per_s`).

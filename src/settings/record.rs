@@ -25,7 +25,7 @@
 //! then every range, and names the first failure ([`Invalid`]).
 
 use super::crc::crc32;
-use crate::protocol::{MAX_SCENE_NAME_LEN, SceneName, Target};
+use crate::protocol::{MAX_SCENE_NAME_LEN, SceneName, Target, TargetRange};
 
 /// Bytes of an encoded record.
 pub const RECORD_LEN: usize = 64;

@@ -45,15 +45,15 @@ fn missing(input: &'static str) -> ModelError {
 
 /// Whether the scene's controller spec and hardware carry every parameter of `fidelity`
 /// (kernels need none), and this build holds the level's model family
-/// ([`ModelKind::in_build`]).
+/// ([`crate::scene::in_build`]).
 pub fn buildable(scene: &Scene<'_>, fidelity: Fidelity) -> bool {
     match fidelity {
         Fidelity::Littmann | Fidelity::DahlUpdate | Fidelity::Coulomb => true,
         Fidelity::DahlSteady => {
-            ModelKind::Dahl.in_build() && scene.controller.k_t_n_per_m.is_some()
+            crate::scene::in_build(ModelKind::Dahl) && scene.controller.k_t_n_per_m.is_some()
         }
         Fidelity::CubeElastic | Fidelity::CubeElasticPlastic => {
-            ModelKind::CubeElasticPlastic.in_build()
+            crate::scene::in_build(ModelKind::CubeElasticPlastic)
                 && scene.horn.is_some()
                 && scene.controller.surface.is_some()
         }

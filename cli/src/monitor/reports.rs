@@ -2,6 +2,7 @@
 //! protocol's own decoders (`decode_u32`, `decode_target`, ...). A missing or undecodable
 //! field is an error that names it.
 
+use sonolube::protocol::TargetRange;
 use sonolube::protocol::{
     NONE, Payload, Reply, SupervisorState, Target, decode_i32, decode_target, decode_u32,
 };

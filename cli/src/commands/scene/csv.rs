@@ -3,6 +3,7 @@
 //!
 //! Columns and units: the `scene` module docs.
 
+use sonolube::protocol::TargetRange;
 use std::fmt::Write as _;
 
 use sonolube::control::Reason;

@@ -34,19 +34,6 @@ impl ModelKind {
             ModelKind::CubeElasticPlastic => 4,
         }
     }
-
-    /// Whether this build holds the model's family: Coulomb always; the others with the core's
-    /// cargo features `exp-coulomb`, `dahl` and `cube` (all on by default). The build script
-    /// compiles in only the scenes whose controller model is in the build (and no horn without
-    /// the cube family).
-    pub const fn in_build(self) -> bool {
-        match self {
-            ModelKind::Coulomb => true,
-            ModelKind::ExpCoulomb => cfg!(feature = "exp-coulomb"),
-            ModelKind::Dahl => cfg!(feature = "dahl"),
-            ModelKind::CubeElastic | ModelKind::CubeElasticPlastic => cfg!(feature = "cube"),
-        }
-    }
 }
 
 /// Rough-surface and material parameters of the cube models (seed 000 Table 2 gives

@@ -1,0 +1,42 @@
+//! The plain data of a Sonolube scene, defined once: the friction models and their parameters,
+//! the hardware (actuator, horn, transducer, load cells), the sensor faults, the time tables,
+//! the friction target, the accuracy, criteria and contents.
+//!
+//! `no_std`, every number in SI `f64` with its unit in the field name. Two crates build scenes
+//! from them: the firmware core (`sonolube::scene::Scene`, borrowing its strings and tables, in
+//! flash) and the scene-file loader (`scene-toml`, owning them, on the host and in the core's
+//! build script, which writes the files as statics of the core's type). The ranges in the field
+//! docs are those of `scenes/README.md`, checked by the loader.
+
+#![no_std]
+
+mod criteria;
+mod fault;
+mod hardware;
+mod spec;
+mod table;
+mod target;
+
+pub use criteria::{Accuracy, Contents, Criterion};
+pub use fault::{Channel, FaultEvent, FaultKind, Rail};
+pub use hardware::{Actuator, ActuatorKind, Horn, LoadCell, ResonanceShift, Stack, Transducer};
+pub use spec::{Mismatch, ModelKind, ModelSpec, RoughSurface};
+pub use table::{Breakpoint, TargetPoint};
+pub use target::Target;
+
+/// Which system of the source papers a scene belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum System {
+    /// Seed 003: PMN-PT stack transducer sliding on an aluminium guide rail, 40 kHz, 0-10 N
+    /// added load.
+    StackOnRail,
+    /// Seeds 000/001: Poisson-effect horn (waveguide) over a sliding block, 20 kHz, 40-240 N.
+    PoissonHorn,
+    /// Seed 002: flexible beam on a moving table (stick-slip rig), exponential Coulomb law,
+    /// with an ultrasonic actuator added at the beam tip.
+    BeamOnTable,
+    /// Application: seat-belt webbing sliding over a vibrated D-ring (seed 003 names seat-belt
+    /// systems as its future work).
+    SeatBelt,
+}
