@@ -96,7 +96,7 @@ pub enum TableError {
 /// four move together by the least amount that clears it (at most 24 sixteenths, 1.5 ticks:
 /// 0.19 degrees at 60 kHz), which keeps the quarter-period spacing.
 ///
-/// Integer arithmetic only (`u64`), no division but by 8: cheap enough for every control step.
+/// `u32` arithmetic, no division but by 8 (a shift): cheap enough for every control step.
 pub const fn phase_table(arr: u32, ccr1: u32) -> Result<[u32; TABLE_LEN], TableError> {
     // 0xFFFE.F: the dithered ARR's largest value (`sonolube::drive::PwmPeriod`).
     if arr > 0x000F_FFEF || arr < 63 * TICK {
@@ -110,12 +110,17 @@ pub const fn phase_table(arr: u32, ccr1: u32) -> Result<[u32; TABLE_LEN], TableE
     let low = TICK;
     let high = arr & !(TICK - 1);
     let mut entries = [0u32; TABLE_LEN];
-    let mut shift: i64 = 0;
+    // The shift that clears the edges, as an amount added modulo the period (0: none).
+    let mut shift = 0u32;
     let mut j = 0;
     while j < TABLE_LEN {
-        // 8 x (CCR1/2 + (2j + 1) T/8), rounded to the nearest sixteenth.
-        let eighths = 4 * ccr1 as u64 + (2 * j as u64 + 1) * period as u64;
-        let x = ((eighths + 4) / 8 % period as u64) as u32;
+        // 8 x (CCR1/2 + (2j + 1) T/8) <= 4 (T + 1)/2 + 7 T < 2^24 for T < 2^20: no overflow.
+        let eighths = 4 * ccr1 + (2 * j as u32 + 1) * period;
+        // Rounded to the nearest sixteenth; below 9 T/8 + 1, so one subtraction wraps it.
+        let mut x = (eighths + 4) / 8;
+        if x >= period {
+            x -= period;
+        }
         entries[j] = x;
         if x < low || x >= high {
             // Up to `low` (through the wrap) or down below `high` (through the wrap).
@@ -124,18 +129,21 @@ pub const fn phase_table(arr: u32, ccr1: u32) -> Result<[u32; TABLE_LEN], TableE
             } else {
                 (period - x + low, x - high + 1)
             };
-            shift = if up <= down {
-                up as i64
-            } else {
-                -(down as i64)
-            };
+            shift = if up <= down { up } else { period - down };
         }
         j += 1;
     }
-    let mut j = 0;
-    while j < TABLE_LEN {
-        entries[j] = ((entries[j] as i64 + shift).rem_euclid(period as i64)) as u32;
-        j += 1;
+    if shift != 0 {
+        let mut j = 0;
+        while j < TABLE_LEN {
+            let moved = entries[j] + shift;
+            entries[j] = if moved >= period {
+                moved - period
+            } else {
+                moved
+            };
+            j += 1;
+        }
     }
     Ok(entries)
 }
