@@ -46,7 +46,7 @@ use crate::pac::bdma::regs::Cr;
 use crate::pac::bdma::vals::{Dir, Pl, Size};
 use crate::pac::dmamux::Dmamux;
 use crate::pac::timer::TimAdv;
-use crate::pac::timer::regs::Ccr1ch;
+use crate::pac::timer::regs::{Ccr1ch, SrAdv};
 
 /// Entries of the ADC2 ring (a multiple of 4, so a ring index names a phase).
 pub const RING_LEN: usize = 16;
@@ -316,8 +316,8 @@ pub enum StartRefused {
 /// Starts the stepped current sampling, with TIM1's counter stopped so that conversion 0 is
 /// taken in period 0 at phase 0: counter stopped (CR1.CEN = 0), ADC2's plan, the ring's DMA
 /// channel, the table's DMA channel, CCR4 = phase 0 and an update (EGR.UG, update DMA still
-/// off) to make it active, CCR4 = phase 1 in the preload for period 1, DIER.UDE (the table
-/// then feeds period 2 on), ADC2 ADSTART (waiting for triggers), counter started.
+/// off) to make it active, UIF cleared, CCR4 = phase 1 in the preload for period 1, DIER.UDE
+/// (the table then feeds period 2 on), ADC2 ADSTART (waiting for triggers), counter started.
 ///
 /// `phases` is [`phase_table`] for the registers in force. Refused, with nothing written,
 /// while MOE is set or ADC2 is disabled or converting.
@@ -387,6 +387,9 @@ pub fn start(
     hook("TIM1_CCR4");
     tim.egr().write(|w| w.set_ug(true));
     hook("TIM1_EGR");
+    // UG set UIF: cleared before UDE, so that no request can be taken for that old update.
+    tim.sr().write_value(SrAdv(crate::tim1::SR_CLEAR_UIF));
+    hook("TIM1_SR");
     tim.ccr(3).write_value(Ccr1ch(phases[1]));
     hook("TIM1_CCR4");
     tim.dier().modify(|w| w.set_ude(true));

@@ -12,6 +12,7 @@ use crate::image::Image;
 // RM0440 offsets. TIM1:
 const TIM_CR1: usize = 0x00;
 const TIM_DIER: usize = 0x0C;
+const TIM_SR: usize = 0x10;
 const TIM_EGR: usize = 0x14;
 const TIM_CCR4: usize = 0x40;
 const TIM_BDTR: usize = 0x44;
@@ -404,6 +405,7 @@ fn the_start_aligns_period_0_with_phase_0() {
             "TIM1_DIER",
             "TIM1_CCR4",
             "TIM1_EGR",
+            "TIM1_SR",
             "TIM1_CCR4",
             "TIM1_DIER",
             "ADC2_CR",
@@ -437,6 +439,19 @@ fn the_start_aligns_period_0_with_phase_0() {
             assert_eq!(word(tim, TIM_DIER) & (1 << 8), 0, "UDE at UG");
         }
     }
+    // UG's UIF is cleared (bit 0 written 0, the break flags written 1) before UDE is set.
+    let sr = names.iter().position(|n| *n == "TIM1_SR").unwrap();
+    assert_eq!(word(&steps[sr].1[0], TIM_SR) & 1, 0, "UIF cleared");
+    assert_eq!(
+        word(&steps[sr].1[0], TIM_SR) & 0x2180,
+        0x2180,
+        "BIF, B2IF, SBIF kept"
+    );
+    assert_eq!(
+        word(&steps[sr].1[0], TIM_DIER) & (1 << 8),
+        0,
+        "UDE after the clear"
+    );
     // UDE is set after the preload holds phase 1, and before the counter starts.
     let ude = names.iter().rposition(|n| *n == "TIM1_DIER").unwrap();
     let ccr4 = names.iter().rposition(|n| *n == "TIM1_CCR4").unwrap();
