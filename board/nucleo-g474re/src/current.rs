@@ -36,6 +36,8 @@ static RING: [AtomicU16; RING_LEN] = [const { AtomicU16::new(0) }; RING_LEN];
 static RUNNING: AtomicBool = AtomicBool::new(false);
 /// Update events suppressed by frequency changes since [`start`], mod 4.
 static SKIPPED: AtomicU8 = AtomicU8::new(0);
+/// The same, counted (for the log: each costs up to 3 samples off their phase).
+static SUPPRESSED: AtomicU32 = AtomicU32::new(0);
 
 const _: () = assert!(RING_LEN < MAX_CURRENT_SAMPLES + 1, "a drain fits one push");
 
@@ -118,7 +120,14 @@ pub fn note_update_events(events: UpdateEvents) {
     if events == UpdateEvents::OneSuppressed {
         let skipped = SKIPPED.load(Ordering::Relaxed);
         SKIPPED.store(skipped.wrapping_add(1) % TABLE_LEN as u8, Ordering::Relaxed);
+        let total = SUPPRESSED.load(Ordering::Relaxed);
+        SUPPRESSED.store(total.saturating_add(1), Ordering::Relaxed);
     }
+}
+
+/// Update events suppressed by frequency changes since [`start`].
+pub fn suppressed_updates() -> u32 {
+    SUPPRESSED.load(Ordering::Relaxed)
 }
 
 /// Rewrites the table for the registers `timing` and `amplitude` put in TIM1 (CCR1/2 moves the

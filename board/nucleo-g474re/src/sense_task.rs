@@ -321,7 +321,8 @@ fn log_sensors(
     defmt::info!(
         "sense: normal {=i32} mN (code {=i32}), tangential {=i32} mN (code {=i32}), \
          current {=i32} mA (code {=i32}); comparators {}, break {=bool}, \
-         outputs {=bool}, overruns {=u32}, malformed reads {=u32}, pairs dropped {=u32}",
+         outputs {=bool}, overruns {=u32}, malformed reads {=u32}, pairs dropped {=u32}, \
+         trigger updates suppressed {=u32}",
         normal.0,
         normal.1,
         tangential.0,
@@ -333,7 +334,8 @@ fn log_sensors(
         drive::outputs_enabled(),
         overruns,
         malformed,
-        cells::dropped()
+        cells::dropped(),
+        current::suppressed_updates()
     );
     for (name, (_, _, faults, last)) in [
         ("normal", normal),
