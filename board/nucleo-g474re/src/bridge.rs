@@ -145,15 +145,16 @@ impl Bridge {
     }
 
     /// Applies one controller output: drive at its amplitude in the driving states, and while
-    /// the resonance search runs (`searching`: a `start` after `freq auto` searches before the
-    /// friction loop starts, the station then commands the search's amplitude); safe in every
-    /// other case. Err when the bridge should switch but does not (see [`Stopped`]); the
+    /// the resonance search runs and the station commands its amplitude (`searching`: a `start`
+    /// after `freq auto` searches before the friction loop starts); safe in every other case. Err when the bridge should switch but does not (see [`Stopped`]); the
     /// bridge is then safe.
     pub fn apply(&mut self, output: &Output, searching: bool) -> Result<(), Stopped> {
         if !CONTROLS_BRIDGE {
             return Ok(());
         }
-        let drives = (searching
+        // A search the station does not drive (stopped meanwhile) leaves the bridge off.
+        let search_drives = searching && output.amplitude > Q1_31::ZERO;
+        let drives = (search_drives
             || matches!(
                 output.state,
                 SupervisorState::RampUp | SupervisorState::Running | SupervisorState::RampDown

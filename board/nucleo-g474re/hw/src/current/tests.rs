@@ -524,3 +524,64 @@ fn a_stalled_channel_or_converter_is_named() {
     images.adc.set_word(ADC_CR, 1 << 28 | 1);
     assert_eq!(check(&mut images).0, Err(Stalled::Adc));
 }
+
+/// The current's fundamental measured from the four samples the table takes, by the core's
+/// lock-in as the station runs it (`LockIn::synchronous`, first phase 1/8 turn), for a
+/// current leading the voltage's fundamental by `lead_deg`. `first` is the phase index of the
+/// first sample given to the lock-in (0 when aligned).
+fn measured_lead_deg(hz: u32, amplitude: Amplitude, lead_deg: f64, first: usize) -> f64 {
+    use sonolube::resonance::{
+        LockIn, LockInConfig, SYNCHRONOUS_FIRST_PHASE, SYNCHRONOUS_PHASE_STEP, current_sample,
+    };
+    let timing = timing(hz);
+    let arr = timing.period().arr_register();
+    let ccr1 = timing.duty_compare(amplitude);
+    let period = f64::from(arr + 16);
+    let phases = phase_table(arr, ccr1).unwrap();
+    let config = LockInConfig {
+        sample_rate_hz: hz,
+        periods_per_window: 1,
+        sense_delay_ns: 0,
+    };
+    let mut lock_in =
+        LockIn::synchronous(config, timing.frequency(), SYNCHRONOUS_PHASE_STEP).unwrap();
+    lock_in.set_drive_phase(SYNCHRONOUS_FIRST_PHASE);
+    // The voltage's fundamental peaks at CCR1/2 (the high-side pulse runs from 0 to CCR1).
+    let maximum = f64::from(ccr1) / 2.0;
+    for k in 0..4 {
+        let entry = f64::from(phases[(first + k) % 4]);
+        let angle = std::f64::consts::TAU * (entry - maximum) / period + lead_deg.to_radians();
+        let code = (2048.0 + 1500.0 * angle.cos()).round() as u16;
+        if let Some(window) = lock_in.push(current_sample(code)) {
+            return window.phasor.polar().phase.to_radians().to_degrees();
+        }
+    }
+    panic!("no window after four samples");
+}
+
+#[test]
+fn the_table_samples_at_the_phases_the_lock_in_assumes() {
+    for hz in [20_000, 33_333, 40_000, 47_123, 60_000] {
+        for amplitude in [
+            Amplitude::ZERO,
+            Amplitude::from_ratio(1, 10).unwrap(),
+            Amplitude::from_ratio(1, 2).unwrap(),
+            // Duty 1/4: the table moved off the period edge.
+            Amplitude::from_ratio(707, 1000).unwrap(),
+            Amplitude::FULL,
+        ] {
+            for lead in [-80.0, -30.0, 0.0, 45.0, 90.0] {
+                let measured = measured_lead_deg(hz, amplitude, lead, 0);
+                assert!(
+                    (measured - lead).abs() < 0.3,
+                    "{hz} Hz, amplitude {}: current leading {lead} deg measured at {measured}",
+                    amplitude.fraction().to_f64()
+                );
+            }
+        }
+    }
+    // A reader starting one sample late (phase index 1) reads the phase a quarter turn off:
+    // why the rig starts each station at phase index 0.
+    let late = measured_lead_deg(40_000, Amplitude::from_ratio(1, 2).unwrap(), 0.0, 1);
+    assert!((late.abs() - 90.0).abs() < 0.3, "{late}");
+}
