@@ -68,6 +68,8 @@ pub enum DriveRefusal {
 /// The bridge settings of one scene and whether the control loop has switched it on.
 pub struct Bridge {
     timing: DriveTiming,
+    /// The stack ratings on this bridge (integer ceilings per frequency).
+    limits: DriveLimits,
     /// Bridge amplitude per controller amplitude, Q2.30 in (0, 1].
     scale_q30: i64,
     /// The stack ratings' ceiling at the drive frequency.
@@ -103,6 +105,7 @@ impl Bridge {
             DriveLimits::new(&config::STACK, config::FULL_SCALE_V).map_err(DriveRefusal::Drive)?;
         Ok(Self {
             timing,
+            limits,
             // ratio in (0, 1]: at most 2^30.
             scale_q30: (ratio * (1u64 << 30) as f64 + 0.5) as i64,
             ceiling: limits.max_amplitude(frequency),
@@ -120,6 +123,11 @@ impl Bridge {
         }
     }
 
+    /// The timing in force.
+    pub fn timing(&self) -> &DriveTiming {
+        &self.timing
+    }
+
     /// The timing for a new drive frequency (`freq` command), checked but not yet written.
     pub fn timing_at(&self, frequency: Frequency) -> Result<DriveTiming, DriveError> {
         self.timing.retune(frequency)
@@ -129,26 +137,29 @@ impl Bridge {
     /// next PWM period boundary, glitch-free (preloaded registers), with the same amplitude.
     pub fn retune(&mut self, timing: DriveTiming) {
         self.timing = timing;
-        if let Ok(limits) = DriveLimits::new(&config::STACK, config::FULL_SCALE_V) {
-            self.ceiling = limits.max_amplitude(timing.frequency());
-        }
+        self.ceiling = self.limits.max_amplitude(timing.frequency());
         self.amplitude = self.amplitude.min(self.ceiling);
         if CONTROLS_BRIDGE {
             drive::write_timing(&self.timing, self.amplitude);
         }
     }
 
-    /// Applies one controller output: drive at its amplitude in the driving states, safe in
-    /// every other. Err when the bridge should switch but does not (see [`Stopped`]); the
+    /// Applies one controller output: drive at its amplitude in the driving states, and while
+    /// the resonance search runs and the station commands its amplitude (`searching`: a `start`
+    /// after `freq auto` searches before the friction loop starts); safe in every other case. Err when the bridge should switch but does not (see [`Stopped`]); the
     /// bridge is then safe.
-    pub fn apply(&mut self, output: &Output) -> Result<(), Stopped> {
+    pub fn apply(&mut self, output: &Output, searching: bool) -> Result<(), Stopped> {
         if !CONTROLS_BRIDGE {
             return Ok(());
         }
-        let drives = matches!(
-            output.state,
-            SupervisorState::RampUp | SupervisorState::Running | SupervisorState::RampDown
-        ) && output.fault.is_none();
+        // A search the station does not drive (stopped meanwhile) leaves the bridge off.
+        let search_drives = searching && output.amplitude > Q1_31::ZERO;
+        let drives = (search_drives
+            || matches!(
+                output.state,
+                SupervisorState::RampUp | SupervisorState::Running | SupervisorState::RampDown
+            ))
+            && output.fault.is_none();
         if !drives {
             self.off();
             return Ok(());

@@ -20,7 +20,7 @@ use embassy_stm32::peripherals::{PA8, PB13, TIM1};
 use sonolube::drive::{Amplitude, DriveTiming};
 use sonolube_g474_hw::{protect, tim1};
 
-use crate::safe;
+use crate::{current, safe};
 
 /// TIM1 and its two pins, owned and configured as the drive. Keep it alive.
 pub struct Drive {
@@ -53,19 +53,32 @@ impl Drive {
     }
 }
 
-/// Writes period, duty for `amplitude` and the ADC trigger together (update events held off
-/// during the write). A timing whose dead time differs from the locked one is refused: logged,
-/// and the drive made safe.
+/// Writes period and duty for `amplitude` together (update events held off during the write),
+/// and the ADC trigger: CCR4 itself until the stepped current sampling runs, the table of
+/// [`crate::current`] afterwards (an update event suppressed by the write is counted there). A
+/// timing whose dead time differs from the locked one is refused: logged, and the drive made
+/// safe.
 pub fn write_timing(timing: &DriveTiming, amplitude: Amplitude) {
-    if let Err(refused) = tim1::write_timing(pac::TIM1, timing, amplitude, &mut |_| {}) {
-        safe::drive_safe();
-        defmt::error!("TIM1 timing refused: {}", refused);
+    let written = if current::running() {
+        tim1::write_timing_stepped(pac::TIM1, timing, amplitude, &mut |_| {})
+            .map(current::note_update_events)
+    } else {
+        tim1::write_timing(pac::TIM1, timing, amplitude, &mut |_| {})
+    };
+    match written {
+        Ok(()) => current::follow_drive(timing, amplitude),
+        Err(refused) => {
+            safe::drive_safe();
+            defmt::error!("TIM1 timing refused: {}", refused);
+        }
     }
 }
 
-/// Sets the duty for `amplitude` (CCR1, dithered), effective at the next period.
+/// Sets the duty for `amplitude` (CCR1, dithered), effective at the next period, and moves the
+/// stepped ADC trigger's table with the fundamental's maximum (CCR1/2).
 pub fn set_amplitude(timing: &DriveTiming, amplitude: Amplitude) {
     tim1::set_amplitude(pac::TIM1, timing, amplitude, &mut |_| {});
+    current::follow_drive(timing, amplitude);
 }
 
 /// Sets MOE: the bridge switches. Refused (returns false) while a break flag is set; false too

@@ -33,6 +33,7 @@ mod bringup;
 mod cells;
 mod config;
 mod console;
+mod current;
 mod drive;
 mod ext_adc;
 mod overcurrent;
@@ -386,6 +387,11 @@ async fn main(spawner: Spawner) {
         tangential_force: p.PB0,
         drive_current: p.PA1,
         dma: p.DMA1_CH1,
+        current: current::Hardware {
+            adc: p.ADC2,
+            ring_dma: p.DMA1_CH2,
+            table_dma: p.DMA1_CH3,
+        },
         #[cfg(feature = "bringup")]
         button: p.PC13,
     });

@@ -29,16 +29,18 @@ use cortex_m::peripheral::DWT;
 use sonolube::control::{ExternalFault, Reason, controller_settings};
 use sonolube::drive::Frequency;
 use sonolube::protocol::{Axis, Command, DRIVE_FREQ, ProtocolError, SupervisorState, TokenText};
+use sonolube::resonance::LockState;
 use sonolube::scene::Scene;
 use sonolube::sense::{Calibration, SenseError, SensorChannel};
-use sonolube::station::{CellBench, Sample, Station, StationError};
+use sonolube::station::{CellBench, MAX_CURRENT_SAMPLES, Sample, Station, StationError};
 use sonolube_app::control::ControlLoop;
 use sonolube_app::snapshot::Snapshot;
 
 use crate::bridge::{Bridge, CONTROLS_BRIDGE, DriveRefusal};
 use crate::cells::{CellFeed, RawPair};
+use crate::current::RingReader;
 use crate::sensing::TRIGGERS_PER_TRIPLET;
-use crate::{config, drive};
+use crate::{config, current, drive};
 
 /// A pair held for more than this many times the longest expected hold is stale.
 pub const STALE_HOLDS: u32 = 8;
@@ -79,8 +81,12 @@ impl Setup {
         .map_err(SceneRefusal::Drive)?;
         let hold = hold_steps(scene.control_rate_hz);
         let channel = cell_channel(calibration, hold);
-        let station = Station::new(scene, &controller_settings(scene), channel, channel)
+        let mut station = Station::new(scene, &controller_settings(scene), channel, channel)
             .map_err(SceneRefusal::Station)?;
+        if current::running() {
+            // ADC2 samples the drive current at the stepped phases: `freq auto` can run.
+            station.enable_current_sense();
+        }
         let sliding_velocity_m_per_s = scene
             .sliding_velocity_m_per_s
             .first()
@@ -122,6 +128,10 @@ pub fn cell_channel(calibration: Calibration, hold: u32) -> SensorChannel {
 pub struct BoardRig {
     setup: Setup,
     feed: CellFeed,
+    /// The drive current's ring (None when the stepped sampling did not start).
+    current: Option<RingReader>,
+    /// The ring stopped (logged once).
+    current_stalled: bool,
 }
 
 impl BoardRig {
@@ -132,6 +142,8 @@ impl BoardRig {
         Ok(Self {
             setup,
             feed: CellFeed::new(first),
+            current: RingReader::new(),
+            current_stalled: false,
         })
     }
 
@@ -188,6 +200,10 @@ impl BoardRig {
                 self.setup.bridge.off();
                 self.setup = setup;
                 self.setup.bridge.install();
+                // The new station's lock-in starts at phase 0.
+                if let Some(reader) = self.current.as_mut() {
+                    reader.realign();
+                }
                 defmt::info!(
                     "scene {=str}: {=f64} Hz control, drive {=f64} Hz, set speed {=f32} m/s",
                     scene.name,
@@ -233,6 +249,55 @@ impl BoardRig {
         self.setup.station.execute(command, &mut bench)?;
         self.setup.bridge.retune(timing);
         Ok(())
+    }
+
+    /// The drive current converted since the last step into the station (its resonance loop),
+    /// then the drive moved to the frequency the loop chose (`freq auto`). A stopped ring is
+    /// logged once; while `freq auto` runs it latches `resonance-lost` (drive safe).
+    fn feed_current(&mut self) {
+        let Some(reader) = self.current.as_mut() else {
+            return;
+        };
+        let setup = &mut self.setup;
+        let mut codes = [0u16; MAX_CURRENT_SAMPLES];
+        match reader.drain(&mut codes) {
+            Ok(count) => {
+                if count > 0 {
+                    setup
+                        .station
+                        .push_current(codes.get(..count).unwrap_or(&[]));
+                }
+            }
+            Err(stalled) => {
+                if !self.current_stalled {
+                    self.current_stalled = true;
+                    defmt::error!("current sense stopped ({}): no resonance tracking", stalled);
+                }
+                let auto = setup
+                    .station
+                    .resonance()
+                    .is_some_and(|report| report.state != LockState::Pinned);
+                if auto {
+                    setup
+                        .station
+                        .controller_mut()
+                        .trip(ExternalFault::ResonanceLost);
+                }
+                return;
+            }
+        }
+        let Some(report) = setup.station.resonance() else {
+            return;
+        };
+        if report.state == LockState::Pinned {
+            return;
+        }
+        // The loop's frequency is on TIM1's grid (`Tuning`): the same period comes back.
+        if let Ok(timing) = setup.bridge.timing_at(report.frequency)
+            && timing.period() != setup.bridge.timing().period()
+        {
+            setup.bridge.retune(timing);
+        }
     }
 
     fn wrong_state(&self, command: &Command) -> ProtocolError {
@@ -293,6 +358,7 @@ impl ControlLoop for BoardRig {
 
     fn step(&mut self) -> Option<Snapshot> {
         let start = DWT::cycle_count();
+        self.feed_current();
         let setup = &mut self.setup;
         let (pair, held) = self.feed.take(drive::outputs_enabled());
         let (normal_code, tangential_code) = if held > setup.stale_after_steps {
@@ -306,7 +372,12 @@ impl ControlLoop for BoardRig {
             tangential_code,
             sliding_velocity_m_per_s: setup.sliding_velocity_m_per_s,
         });
-        let applied = setup.bridge.apply(&control.output);
+        // A search started by `start` drives its own amplitude before the friction loop runs.
+        let searching = setup
+            .station
+            .resonance()
+            .is_some_and(|report| report.state == LockState::Searching);
+        let applied = setup.bridge.apply(&control.output, searching);
         let cycles = DWT::cycle_count().wrapping_sub(start);
         if let Err(cause) = applied {
             defmt::error!(

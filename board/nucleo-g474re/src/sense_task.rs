@@ -11,7 +11,7 @@ use sonolube::sense::{Calibration, SampleError, SensorChannel};
 use crate::cells::{self, RawPair};
 use crate::overcurrent::{self, OvercurrentGuard, Thresholds};
 use crate::sensing::{self, Block, CHANNELS, ChannelLog, SCANS_PER_READ};
-use crate::{SELF_CHECK_PASSED, SENSING_STARTED, config, drive, safe};
+use crate::{SELF_CHECK_PASSED, SENSING_STARTED, config, current, drive, safe};
 
 /// Everything the task owns.
 pub struct Hardware {
@@ -33,6 +33,8 @@ pub struct Hardware {
     pub drive_current: Peri<'static, PA1>,
     /// The ADC's DMA channel.
     pub dma: Peri<'static, DMA1_CH1>,
+    /// ADC2 and its two DMA channels: the drive current at stepped phases (resonance loop).
+    pub current: current::Hardware,
     /// USER button B1, hold-to-run in the bring-up build.
     #[cfg(feature = "bringup")]
     pub button: Peri<'static, embassy_stm32::peripherals::PC13>,
@@ -63,6 +65,24 @@ pub async fn run(hw: Hardware) {
         }
     };
     log_timing(&timing);
+    // The stepped current sampling first: it stops TIM1's counter for a few microseconds to
+    // align period 0 with phase 0, before ADC1 takes triggers.
+    let _current = match current::start(hw.current, &timing) {
+        Ok(sense) => {
+            defmt::info!(
+                "ADC2: PA1 current, one conversion per TIM1 TRGO2, CCR4 stepped by DMA \
+                 (TIM1_UP) to 1/8, 3/8, 5/8, 7/8 of the period after CCR1/2; resonance loop fed"
+            );
+            Some(sense)
+        }
+        Err(error) => {
+            defmt::error!(
+                "ADC2 stepped sampling did not start ({}); `freq auto` unavailable",
+                error
+            );
+            None
+        }
+    };
 
     let Ok(nominal_current) = config::CURRENT_SENSE.calibration() else {
         defmt::error!("current-sense calibration out of range; drive stays off");
@@ -111,13 +131,23 @@ pub async fn run(hw: Hardware) {
             return;
         }
     };
-    defmt::info!(
-        "ADC1: PA0 normal, PB0 tangential, PA1 current; one scan per TIM1 TRGO2, \
-         {=u32} ns per scan in a {=u32} ns quiet window; a triplet every {=u32} PWM periods",
-        config::ADC_SCAN_NS,
-        timing.quiet_window_ns(),
-        sensing::TRIGGERS_PER_TRIPLET
-    );
+    if current::running() {
+        // The scan follows the stepped trigger: it may straddle a switching edge.
+        defmt::info!(
+            "ADC1: PA0 normal, PB0 tangential, PA1 current; one scan per TIM1 TRGO2 (the \
+             stepped trigger), {=u32} ns per scan; a triplet every {=u32} PWM periods",
+            config::ADC_SCAN_NS,
+            sensing::TRIGGERS_PER_TRIPLET
+        );
+    } else {
+        defmt::info!(
+            "ADC1: PA0 normal, PB0 tangential, PA1 current; one scan per TIM1 TRGO2, \
+             {=u32} ns per scan in a {=u32} ns quiet window; a triplet every {=u32} PWM periods",
+            config::ADC_SCAN_NS,
+            timing.quiet_window_ns(),
+            sensing::TRIGGERS_PER_TRIPLET
+        );
+    }
 
     // The first triplets, with the drive off, are the current sense's zero (an overrun only
     // loses samples).
@@ -291,7 +321,8 @@ fn log_sensors(
     defmt::info!(
         "sense: normal {=i32} mN (code {=i32}), tangential {=i32} mN (code {=i32}), \
          current {=i32} mA (code {=i32}); comparators {}, break {=bool}, \
-         outputs {=bool}, overruns {=u32}, malformed reads {=u32}, pairs dropped {=u32}",
+         outputs {=bool}, overruns {=u32}, malformed reads {=u32}, pairs dropped {=u32}, \
+         trigger updates suppressed {=u32}",
         normal.0,
         normal.1,
         tangential.0,
@@ -303,7 +334,8 @@ fn log_sensors(
         drive::outputs_enabled(),
         overruns,
         malformed,
-        cells::dropped()
+        cells::dropped(),
+        current::suppressed_updates()
     );
     for (name, (_, _, faults, last)) in [
         ("normal", normal),

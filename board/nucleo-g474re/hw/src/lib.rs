@@ -8,6 +8,7 @@
 //! | [`safe`] | the safe state (MOE cleared, PA8/PB13 driven low as GPIO) |
 //! | [`protect`] | COMP1 + DAC3 (stack current), COMP3 + DAC1 (bus shunt), SYSCFG_CFGR2, DBGMCU |
 //! | [`adc`] | ADC1 regular sequence, trigger, oversampling, DMA mode; DMA1/DMAMUX check |
+//! | [`current`] | ADC2 (drive current) at the stepped trigger phases: CCR4 table by DMA on TIM1_UP, ADC2 ring |
 //! | [`iwdg`] | the independent watchdog (50 ms on the 32 kHz LSI) |
 //! | [`clock`] | HSE start with timeout, clock security, FLASH_ACR |
 //!
@@ -22,6 +23,7 @@ pub use stm32_metapac as pac;
 
 pub mod adc;
 pub mod clock;
+pub mod current;
 pub mod iwdg;
 pub mod protect;
 pub mod safe;

@@ -274,6 +274,56 @@ pub fn write_timing(
     Ok(())
 }
 
+/// TIM1_SR value that clears UIF alone (rc_w0: every other flag bit written 1, reserved bits 0).
+pub const SR_CLEAR_UIF: u32 = 0x00F3_3FFE;
+
+/// Whether an update event fell inside [`write_timing_stepped`]'s UDIS window.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum UpdateEvents {
+    /// Every period boundary produced its update (and its DMA request).
+    AllTaken,
+    /// One period boundary passed with UDIS set: no shadow load, no update DMA request.
+    OneSuppressed,
+}
+
+/// [`write_timing`] for the stepped ADC trigger ([`crate::current`]): ARR and CCR1 under
+/// CR1.UDIS, CCR4 left to the DMA table, and the suppressed update detected. UIF is cleared
+/// first and the counter read before UDIS is set and after it is cleared: the counter went
+/// backwards (it wrapped; the window is far shorter than a period) while no update event set
+/// UIF exactly when the wrap happened with UDIS set. (A wrap before UDIS took effect or after
+/// it was cleared sets UIF.) Refused, with nothing written, as [`write_timing`].
+pub fn write_timing_stepped(
+    tim: TimAdv,
+    timing: &DriveTiming,
+    amplitude: Amplitude,
+    hook: &mut impl FnMut(Step),
+) -> Result<UpdateEvents, Refused> {
+    if tim.bdtr().read().dtg() != timing.dead_time().dtg() {
+        return Err(Refused::DeadTimeDiffers);
+    }
+    tim.sr().write_value(SrAdv(SR_CLEAR_UIF));
+    hook("TIM1_SR");
+    let before = tim.cnt().read().cnt();
+    tim.cr1().modify(|w| w.set_udis(true));
+    hook("TIM1_CR1");
+    tim.arr_dither()
+        .write_value(ArrDitherCore(timing.period().arr_register()));
+    hook("TIM1_ARR");
+    tim.ccr_dither(CH1)
+        .write_value(CcrDither1ch(timing.duty_compare(amplitude)));
+    hook("TIM1_CCR1");
+    tim.cr1().modify(|w| w.set_udis(false));
+    hook("TIM1_CR1");
+    let after = tim.cnt().read().cnt();
+    let updated = tim.sr().read().uif();
+    Ok(if after < before && !updated {
+        UpdateEvents::OneSuppressed
+    } else {
+        UpdateEvents::AllTaken
+    })
+}
+
 /// Sets the duty for `amplitude` (CCR1, dithered), effective at the next period. One register,
 /// so no update event can split it.
 pub fn set_amplitude(

@@ -439,3 +439,116 @@ fn pins_are_connected_low_first_then_to_af6() {
         assert!(bsrr < moder, "{port}: output low before the mode switch");
     }
 }
+
+/// TIM1_CNT (counter, bits 0-15).
+const CNT: usize = 0x24;
+
+/// `write_timing_stepped` on a configured image whose counter reads `count` before the
+/// write; `wrap` moves the counter back to 3 at the named step (the counter wrapping right
+/// after that write), setting UIF when `uif`.
+fn stepped(count: u32, wrap: Option<(usize, bool)>) -> (UpdateEvents, Vec<(Step, Vec<u32>)>) {
+    let mut image = configured(40_000);
+    image.set_word(CNT, count);
+    image.set_word(SR, 1); // a stale UIF from long ago
+    let ptr = &mut *image as *mut Image;
+    let handle = tim(&mut image);
+    let new = timing(47_000);
+    let mut steps = Vec::new();
+    let mut index = 0;
+    let events = write_timing_stepped(
+        handle,
+        &new,
+        Amplitude::from_ratio(1, 2).unwrap(),
+        &mut |step| {
+            // SAFETY: the image is alive; the handle's accesses are volatile and not concurrent.
+            let image = unsafe { &mut *ptr };
+            if step == "TIM1_SR" {
+                // rc_w0: the written zeros clear, the ones leave a flag as it was.
+                let written = image.word(SR);
+                image.set_word(SR, written & 1);
+            }
+            if let Some((at, uif)) = wrap
+                && at == index
+            {
+                image.set_word(CNT, 3);
+                if uif {
+                    image.set_word(SR, image.word(SR) | 1);
+                }
+            }
+            steps.push((step, image.snapshot()));
+            index += 1;
+        },
+    )
+    .unwrap();
+    (events, steps)
+}
+
+#[test]
+fn the_stepped_timing_write_leaves_ccr4_to_the_dma_and_finds_a_suppressed_update() {
+    let (events, steps) = stepped(1_000, None);
+    assert_eq!(events, UpdateEvents::AllTaken);
+    let names: Vec<Step> = steps.iter().map(|(s, _)| *s).collect();
+    assert_eq!(
+        names,
+        ["TIM1_SR", "TIM1_CR1", "TIM1_ARR", "TIM1_CCR1", "TIM1_CR1"]
+    );
+    let new = timing(47_000);
+    let half = Amplitude::from_ratio(1, 2).unwrap();
+    let last = &steps[4].1;
+    assert_eq!(word(last, ARR), new.period().arr_register());
+    assert_eq!(word(last, CCR1_OFFSET), new.duty_compare(half));
+    // CCR4 is the table's: configure's 3/4 trigger at 40 kHz is still there.
+    assert_eq!(
+        word(last, CCR4_OFFSET),
+        timing(40_000).adc_trigger_compare()
+    );
+    // UDIS (CR1 bit 1) set before ARR and cleared after CCR1.
+    assert_eq!(word(&steps[2].1, CR1) & 0b10, 0b10);
+    assert_eq!(word(&steps[3].1, CR1) & 0b10, 0b10);
+    assert_eq!(word(last, CR1) & 0b10, 0);
+    // The SR write clears UIF (bit 0) alone: BIF, B2IF, SBIF and the others are written 1.
+    let sr_written = SR_CLEAR_UIF;
+    assert_eq!(sr_written & 1, 0);
+    for flag in [
+        1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 16, 17, 20, 21, 22, 23,
+    ] {
+        assert_eq!(sr_written >> flag & 1, 1, "SR bit {flag}");
+    }
+    for reserved in [14, 15, 18, 19, 24, 25, 26, 27, 28, 29, 30, 31] {
+        assert_eq!(sr_written >> reserved & 1, 0, "reserved SR bit {reserved}");
+    }
+    // The counter wraps with UDIS set (after the first CR1 write, before the second) and no
+    // update event sets UIF: one update was suppressed.
+    for at in 1..=3 {
+        assert_eq!(
+            stepped(2_000, Some((at, false))).0,
+            UpdateEvents::OneSuppressed,
+            "wrap after step {at}"
+        );
+    }
+    // A wrap that set UIF (before UDIS took effect, or after it was cleared) was an update.
+    for at in 0..=4 {
+        assert_eq!(
+            stepped(2_000, Some((at, true))).0,
+            UpdateEvents::AllTaken,
+            "wrap with UIF after step {at}"
+        );
+    }
+    // The stale UIF of long ago does not count: it is cleared first.
+    assert_eq!(
+        stepped(2_000, Some((2, false))).0,
+        UpdateEvents::OneSuppressed
+    );
+}
+
+#[test]
+fn the_stepped_timing_write_refuses_another_dead_time() {
+    let mut image = configured(40_000);
+    let before = image.snapshot();
+    let other = DriveTiming::new(Frequency::from_hz(40_000), 400, TimerClock::G474_TIM1).unwrap();
+    assert_eq!(
+        write_timing_stepped(tim(&mut image), &other, Amplitude::ZERO, &mut |_| {}),
+        Err(Refused::DeadTimeDiffers)
+    );
+    assert_eq!(image.snapshot(), before);
+}
