@@ -15,6 +15,11 @@
 //! | [`Q2_30`]   | [-2, 2)            | 9.3e-10    | ratios with an exact 1.0, radians <= pi/2 |
 //! | [`Q1_31`]   | [-1, 1)            | 4.7e-10    | states and sines (+1.0 not representable) |
 //!
+//! Quantities that span more decades than any 32-bit format (loads from 1 mN to 50 kN,
+//! stiffness-amplitude products from 1e-9 to 1e13) are [`Scaled`]: `mantissa * 2^exp2`, a Q2.30
+//! mantissa in [1, 2) with 30 significant bits; [`wide`] multiplies, inverts (Newton, no
+//! division), adds and converts them with 32x32->64 multiplies only.
+//!
 //! # Never panic, never wrap
 //!
 //! There are no operator impls. Every operation is either checked (`Result<_, FxError>`, the
@@ -113,12 +118,15 @@ mod ln;
 mod ops;
 mod q;
 mod raw;
+pub mod scaled;
 mod sqrt;
 mod trig;
+pub mod wide;
 
 pub use error::{FxError, Sat};
 pub use ln::ln_scaled;
 pub use q::{Q, Q1_31, Q2_30, Q3_29, Q5_27, Q6_26, Q8_24, Q16_16};
+pub use scaled::Scaled;
 pub use sqrt::isqrt_u64;
 pub use trig::{cos, sin, sin_cos};
 

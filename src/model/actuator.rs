@@ -16,8 +16,9 @@
 use crate::fx::{Q2_30, Q8_24, Q16_16};
 
 use super::ModelError;
-use super::scaled::{Scaled, fx_error};
-use super::wide;
+use super::fx_error;
+use crate::fx::Scaled;
+use crate::fx::wide;
 
 /// SI parameters of the stack (seed 003 Table 1: n = 62, d33 = 730 pm/V, C = 300 nF,
 /// K_stack = 3.14e8 N/m, K_bolt = 3.7e7 N/m, V_max = 15.466 V, I_max = 1.75 A).
@@ -84,9 +85,9 @@ impl ActuatorConstants {
                 reason: "must be a whole number of discs >= 1",
             });
         }
-        let d33 = wide::from_f64(params.d33_m_per_v, "d33")?.to_f64();
-        let c = wide::from_f64(params.capacitance_f, "C")?.to_f64();
-        let k_stack = wide::from_f64(params.stack_stiffness, "K_stack")?.to_f64();
+        let d33 = crate::model::scaled_from_f64(params.d33_m_per_v, "d33")?.to_f64();
+        let c = crate::model::scaled_from_f64(params.capacitance_f, "C")?.to_f64();
+        let k_stack = crate::model::scaled_from_f64(params.stack_stiffness, "K_stack")?.to_f64();
         let k_bolt = params.bolt_stiffness;
         if !k_bolt.is_finite() {
             return Err(ModelError::NonFinite { input: "K_bolt" });
@@ -97,13 +98,16 @@ impl ActuatorConstants {
                 reason: "must be >= 0",
             });
         }
-        let v_max = wide::from_f64(params.max_voltage_v, "V_max")?.to_f64();
-        let i_max = wide::from_f64(params.max_current_a, "I_max")?.to_f64();
+        let v_max = crate::model::scaled_from_f64(params.max_voltage_v, "V_max")?.to_f64();
+        let i_max = crate::model::scaled_from_f64(params.max_current_a, "I_max")?.to_f64();
         let omega_per_khz = core::f64::consts::TAU * 1e3;
         Ok(Self {
-            stroke_per_volt: wide::from_f64(d33 * n * (k_stack / (k_stack + k_bolt)) * 1e6, "d33")?,
-            current_per_volt_khz: wide::from_f64(omega_per_khz * c, "C")?,
-            current_corner: wide::from_f64(i_max / (omega_per_khz * c), "I_max")?,
+            stroke_per_volt: crate::model::scaled_from_f64(
+                d33 * n * (k_stack / (k_stack + k_bolt)) * 1e6,
+                "d33",
+            )?,
+            current_per_volt_khz: crate::model::scaled_from_f64(omega_per_khz * c, "C")?,
+            current_corner: crate::model::scaled_from_f64(i_max / (omega_per_khz * c), "I_max")?,
             max_voltage: Q16_16::from_f64(v_max).map_err(fx_error("V_max"))?,
             max_current: Q8_24::from_f64(i_max).map_err(fx_error("I_max"))?,
         })

@@ -96,12 +96,10 @@ pub mod horn;
 #[path = "coulomb/littmann.rs"]
 pub mod littmann;
 pub mod quadrature;
-pub mod scaled;
-pub mod wide;
 
 pub use any_model::AnyModel;
 
-use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
+use crate::fx::{FxError, Q1_31, Q2_30, Q8_24, Q16_16, Scaled, wide};
 
 /// Why a model could not be evaluated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -266,4 +264,37 @@ pub fn invert<M: FrictionModel + ?Sized>(
         ratio: ratio_high,
         reach: Reach::Reached,
     })
+}
+
+/// A finite, strictly positive SI value (scene load only: f64). `input` names it in the error:
+/// `NonFinite` for NaN and infinities, `OutOfDomain` for values <= 0.
+pub fn scaled_from_f64(x: f64, input: &'static str) -> Result<Scaled, ModelError> {
+    if !x.is_finite() {
+        return Err(ModelError::NonFinite { input });
+    }
+    if x <= 0.0 {
+        return Err(ModelError::OutOfDomain {
+            input,
+            reason: "must be > 0",
+        });
+    }
+    let (fraction, exponent) = libm::frexp(x); // x = fraction 2^exponent, fraction in [0.5, 1)
+    let bits = libm::round(fraction * 2_147_483_648.0) as u64; // [2^30, 2^31]
+    Ok(if bits >> 31 != 0 {
+        wide::make(wide::ONE_BITS, exponent)
+    } else {
+        wide::make(bits, exponent - 1)
+    })
+}
+
+/// Maps an [`FxError`] of a fixed-point step to the [`ModelError`] naming `quantity`.
+pub(crate) fn fx_error(quantity: &'static str) -> impl Fn(FxError) -> ModelError {
+    move |error| match error {
+        FxError::Overflow => ModelError::Overflow { quantity },
+        FxError::NotFinite => ModelError::NonFinite { input: quantity },
+        FxError::DivisionByZero | FxError::Domain => ModelError::OutOfDomain {
+            input: quantity,
+            reason: "outside the domain of a fixed-point function (ln of 0, division by 0)",
+        },
+    }
 }

@@ -22,6 +22,7 @@ use std::collections::BTreeMap;
 
 use super::keys::Keys;
 use sonolube::fx::Q2_30;
+use sonolube::fx::scaled::Scaled;
 use sonolube::model::ModelError;
 use sonolube::model::contact::{
     ContactConstants, ContactKind, ContactParams, ContactState, EStarRule, ln_load_from_si,
@@ -29,7 +30,6 @@ use sonolube::model::contact::{
 use sonolube::model::cube::{CubeOptions, CubeParams, CubeScene, DEFAULT_QUADRATURE_POINTS};
 use sonolube::model::horn::{HornShape, PoissonGain, UPhase, amplitude_um, time_phase};
 use sonolube::model::quadrature::SlipWindow;
-use sonolube::model::scaled::Scaled;
 
 pub use super::Outputs;
 

@@ -25,6 +25,7 @@ use std::collections::BTreeMap;
 
 use super::defined;
 use super::keys::Keys;
+use sonolube::fx::scaled::Scaled;
 use sonolube::fx::{Q, Q1_31, Q2_30, Q8_24, Q16_16};
 use sonolube::model::ModelError;
 use sonolube::model::actuator::{ActuatorConstants, ActuatorParams};
@@ -35,8 +36,6 @@ use sonolube::model::dahl_steady::DahlModel;
 use sonolube::model::dahl_window::DahlWindow;
 use sonolube::model::exp_coulomb::ExpCoulombConstants;
 use sonolube::model::littmann::mu_i;
-use sonolube::model::scaled::Scaled;
-use sonolube::model::wide;
 
 pub use super::Outputs;
 
@@ -280,7 +279,7 @@ fn coulomb_sampled(keys: &mut Keys<'_>) -> Result<Outputs, String> {
     let vibration = if v_a == 0.0 {
         None
     } else {
-        Some(wide::from_f64(v_a, "v_a").map_err(keys.err())?)
+        Some(sonolube::model::scaled_from_f64(v_a, "v_a").map_err(keys.err())?)
     };
     keys.record("v_a", value(vibration));
     let v = keys.speed("v")?;

@@ -23,7 +23,8 @@ use crate::fx::{Q2_30, Q6_26, Q8_24, Q16_16, ln_scaled};
 
 use super::ModelError;
 use super::contact_constants::{self as k, SceneContact};
-use super::scaled::{Scaled, fx_error};
+use super::fx_error;
+use crate::fx::Scaled;
 
 pub use super::contact_constants::{ContactKind, ContactParams, EStarRule};
 

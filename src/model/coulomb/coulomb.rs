@@ -29,10 +29,11 @@
 
 use crate::fx::{Q, Q1_31, Q2_30, Q8_24, sin};
 
+use super::fx_error;
 use super::littmann::{VelocityRatio, velocity_ratio};
-use super::scaled::{Scaled, fx_error};
-use super::wide;
 use super::{FrictionModel, Inversion, ModelError, OperatingPoint, Reach};
+use crate::fx::Scaled;
+use crate::fx::wide;
 
 /// Scene constants of the Coulomb model (seed 003 eqs 2-4), built once from SI values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -55,9 +56,9 @@ impl CoulombConstants {
         full_scale_amplitude_m: f64,
     ) -> Result<Self, ModelError> {
         let mu = friction_coefficient_q("mu", friction_coefficient)?;
-        let frequency = wide::from_f64(frequency_hz, "f")?;
-        let amplitude = wide::from_f64(full_scale_amplitude_m, "x_a")?;
-        let full_scale_velocity = wide::from_f64(
+        let frequency = crate::model::scaled_from_f64(frequency_hz, "f")?;
+        let amplitude = crate::model::scaled_from_f64(full_scale_amplitude_m, "x_a")?;
+        let full_scale_velocity = crate::model::scaled_from_f64(
             core::f64::consts::TAU * frequency.to_f64() * amplitude.to_f64(),
             "v_a",
         )?;

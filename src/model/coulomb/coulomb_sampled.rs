@@ -11,9 +11,10 @@
 use crate::fx::{Q, Q2_30, cos};
 
 use super::ModelError;
+use super::fx_error;
 use super::littmann::{VelocityRatio, velocity_ratio};
-use super::scaled::{Scaled, fx_error};
-use super::wide;
+use crate::fx::Scaled;
+use crate::fx::wide;
 
 /// Largest number of samples accepted (as the reference: 1e8).
 pub const MAX_SAMPLES: u32 = 100_000_000;
@@ -146,7 +147,7 @@ mod tests {
     fn seed003() -> (SampledSign, Option<Scaled>) {
         (
             SampledSign::new(40e3, 1e-7, 1e-3).unwrap(),
-            wide::from_f64(0.0683, "v_a").ok(),
+            crate::model::scaled_from_f64(0.0683, "v_a").ok(),
         )
     }
 
@@ -192,7 +193,7 @@ mod tests {
         assert_eq!(nyquist.increment, 1 << 63);
         let m = nyquist.mean_sign(
             Q8_24::from_f64(-0.5).unwrap(),
-            wide::from_f64(1.0, "v_a").ok(),
+            crate::model::scaled_from_f64(1.0, "v_a").ok(),
         );
         // Phase 0: -0.5 + 1 > 0; phase pi: -0.5 - 1 < 0: the signs cancel.
         assert_eq!(m, Ok(Q2_30::ZERO));

@@ -19,8 +19,9 @@
 use crate::fx::{Q, Q2_30};
 
 use super::ModelError;
-use super::scaled::{Scaled, fx_error};
-use super::wide;
+use super::fx_error;
+use crate::fx::Scaled;
+use crate::fx::wide;
 
 /// zeta = v / v_a, as the hot path carries it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -250,7 +251,7 @@ mod tests {
 
     #[test]
     fn velocity_ratio_cases() {
-        let v_a = wide::from_f64(0.0683, "v_a").unwrap();
+        let v_a = crate::model::scaled_from_f64(0.0683, "v_a").unwrap();
         let v = Q8_24::from_f64(-0.038).unwrap();
         let r = velocity_ratio(v, Some(v_a)).unwrap();
         assert!(r.is_negative());
@@ -274,7 +275,7 @@ mod tests {
         // |v| = v_a exactly: zeta = 1, no reversal.
         let same = velocity_ratio(
             Q8_24::from_f64(0.5).unwrap(),
-            wide::from_f64(0.5, "v_a").ok(),
+            crate::model::scaled_from_f64(0.5, "v_a").ok(),
         );
         assert_eq!(same.unwrap().mu_i(), Ok(Q2_30::ONE));
     }

@@ -30,9 +30,10 @@ use super::ModelError;
 use super::contact::{ContactConstants, ContactKind, ContactParams, ContactState, EStarRule};
 use super::contact_constants::{finite, non_negative, positive};
 use super::cube_nodes::{apart_sums, literal_sums, quotient_q8_24};
+use super::fx_error;
 use super::horn::UPhase;
 use super::quadrature::{Quadrature, SlipWindow};
-use super::scaled::{Scaled, fx_error};
+use crate::fx::Scaled;
 
 /// Default number of quadrature points N.
 pub const DEFAULT_QUADRATURE_POINTS: usize = 16;

@@ -21,8 +21,8 @@ use crate::fx::{Q1_31, Q2_30};
 use super::contact::ln_load;
 use super::cube::{CubeOptions, CubeParams, CubePoint, CubeScene};
 use super::cube_nodes::apart_node;
+use super::fx_error;
 use super::quadrature::SlipWindow;
-use super::scaled::fx_error;
 use super::{BISECTION_STEPS, FrictionModel, Inversion, ModelError, OperatingPoint, Reach, invert};
 
 /// Newton iterations before giving up (returning the best point found).

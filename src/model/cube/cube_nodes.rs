@@ -9,9 +9,10 @@
 use crate::fx::{Q6_26, Q8_24};
 
 use super::ModelError;
+use super::fx_error;
 use super::horn::UPhase;
 use super::quadrature::Quadrature;
-use super::scaled::{Scaled, fx_error};
+use crate::fx::Scaled;
 
 /// Window averages W0 = <G> and W1 = <G P_u> in Q.30 (`i64`), and whether a G saturated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

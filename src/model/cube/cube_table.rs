@@ -53,7 +53,7 @@ use crate::fx::{Q1_31, Q2_30, Q6_26, Q16_16};
 
 use super::contact::{ln_load, ln_load_from_si};
 use super::cube_model::CubeModel;
-use super::scaled::fx_error;
+use super::fx_error;
 use super::{FrictionModel, Inversion, ModelError, OperatingPoint, Reach};
 
 /// Largest side of a table: 17 nodes per axis (see the module docs for 33).

@@ -25,8 +25,8 @@ use super::ModelError;
 use super::coulomb::friction_coefficient_q;
 use super::dahl_relax::RelaxLaw;
 use super::littmann::{VelocityRatio, velocity_ratio};
-use super::scaled::Scaled;
-use super::wide;
+use crate::fx::scaled::Scaled;
+use crate::fx::wide;
 
 /// Largest quadrature node count per period accepted by the periodic models.
 pub const MAX_QUADRATURE_POINTS: u32 = 4096;
@@ -137,9 +137,9 @@ impl DahlConstants {
                 reason: "must be > 0 (F_c = mu W)",
             });
         }
-        let k_t = wide::from_f64(params.tangential_stiffness, "k_t")?.to_f64();
-        let f = wide::from_f64(params.frequency_hz, "f")?.to_f64();
-        let x_a = wide::from_f64(params.full_scale_amplitude_m, "x_a")?.to_f64();
+        let k_t = crate::model::scaled_from_f64(params.tangential_stiffness, "k_t")?.to_f64();
+        let f = crate::model::scaled_from_f64(params.frequency_hz, "f")?.to_f64();
+        let x_a = crate::model::scaled_from_f64(params.full_scale_amplitude_m, "x_a")?.to_f64();
         let points = params.quadrature_points;
         if !points.is_multiple_of(2) || !(4..=MAX_QUADRATURE_POINTS).contains(&points) {
             return Err(ModelError::OutOfDomain {
@@ -150,11 +150,11 @@ impl DahlConstants {
         let omega = core::f64::consts::TAU * f;
         Ok(Self {
             mu,
-            stiffness_amplitude_per_load: wide::from_f64(k_t * x_a / mu_f64, "k_t")?,
-            stiffness_per_mu: wide::from_f64(k_t / mu_f64, "k_t")?,
-            travel_rate_per_load: wide::from_f64(k_t / (mu_f64 * omega), "k_t")?,
-            full_scale_velocity: wide::from_f64(omega * x_a, "x_a")?,
-            full_scale_amplitude: wide::from_f64(x_a, "x_a")?,
+            stiffness_amplitude_per_load: crate::model::scaled_from_f64(k_t * x_a / mu_f64, "k_t")?,
+            stiffness_per_mu: crate::model::scaled_from_f64(k_t / mu_f64, "k_t")?,
+            travel_rate_per_load: crate::model::scaled_from_f64(k_t / (mu_f64 * omega), "k_t")?,
+            full_scale_velocity: crate::model::scaled_from_f64(omega * x_a, "x_a")?,
+            full_scale_amplitude: crate::model::scaled_from_f64(x_a, "x_a")?,
             law: RelaxLaw::new(params.shape_exponent)?,
             points,
         })

@@ -22,8 +22,9 @@ use super::ModelError;
 use super::dahl_quadrature::{SMALL_DECAY_Q30, phi_small};
 use super::dahl_relax::{Decay, RelaxLaw};
 use super::dahl_travel::{PI_Q28, Travel};
-use super::scaled::{Scaled, fx_error};
-use super::wide;
+use super::fx_error;
+use crate::fx::Scaled;
+use crate::fx::wide;
 
 /// Bisection steps of the alpha != 1 fixed point (2^-25 of [-1, 1]).
 const FIXED_POINT_STEPS: u32 = 26;
@@ -247,7 +248,7 @@ mod tests {
                 geometry.backward_travel.unwrap().to_f64(),
             );
             for kxa in [1e-9, 1e-4, 0.1, 1.0, 3.0, 100.0, 1e9] {
-                let k = wide::from_f64(kxa, "kxa").unwrap();
+                let k = crate::model::scaled_from_f64(kxa, "kxa").unwrap();
                 let (a, b) = (-(-kxa * d_f).exp_m1(), -(-kxa * d_b).exp_m1());
                 let want = if kxa * (d_f + d_b) < 1e-12 {
                     (d_f - d_b) / (d_f + d_b)

@@ -32,8 +32,8 @@ use crate::fx::{Q2_30, Q3_29, Q8_24};
 
 use super::dahl_relax::{Decay, RelaxLaw};
 use super::dahl_travel::{Q4_28, Travel, mul32, trig};
-use super::scaled::Scaled;
 use super::wide::{self, umul};
+use crate::fx::scaled::Scaled;
 
 /// The node grid of one stretch: n nodes, and 2^32 / n rounded up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -19,8 +19,9 @@
 use crate::fx::{Q2_30, Q3_29, Q6_26, Q8_24};
 
 use super::ModelError;
-use super::scaled::{Scaled, fx_error};
-use super::wide;
+use super::fx_error;
+use crate::fx::Scaled;
+use crate::fx::wide;
 
 /// Largest shape exponent alpha accepted (as the reference).
 pub const MAX_SHAPE_EXPONENT: f64 = 20.0;
@@ -83,8 +84,8 @@ impl RelaxLaw {
         }
         Ok(Self::Power {
             p: Q8_24::from_f64(p).map_err(fx_error("alpha"))?,
-            abs_p: wide::from_f64(p.abs(), "alpha")?,
-            inv_abs_p: wide::from_f64(1.0 / p.abs(), "alpha")?,
+            abs_p: crate::model::scaled_from_f64(p.abs(), "alpha")?,
+            inv_abs_p: crate::model::scaled_from_f64(1.0 / p.abs(), "alpha")?,
             clamp_share: Q2_30::from_f64(if p > 0.0 { p / (1.0 + p) } else { 0.0 })
                 .map_err(fx_error("alpha"))?,
         })
@@ -233,7 +234,7 @@ mod tests {
                 let g0q = Q3_29::from_f64(g0).unwrap();
                 let factor = law.stretch_factor(g0q).unwrap();
                 for y in [1e-9, 1e-5, 0.01, 0.1, 0.5, 1.0, 3.0, 30.0, 1e4, 1e9] {
-                    let decay = law.decay(wide::from_f64(y, "y").ok(), factor);
+                    let decay = law.decay(crate::model::scaled_from_f64(y, "y").ok(), factor);
                     let got = relaxed(g0q, decay).unwrap().to_f64();
                     let want = relax_f64(g0q.to_f64(), y, alpha);
                     let err = (got - want).abs();
@@ -250,7 +251,7 @@ mod tests {
         let law = RelaxLaw::new(0.5).unwrap();
         let factor = law.stretch_factor(Q3_29::ONE).unwrap();
         assert_eq!(
-            law.decay(wide::from_f64(2.0, "y").ok(), factor),
+            law.decay(crate::model::scaled_from_f64(2.0, "y").ok(), factor),
             Decay::Vanished
         );
         assert_eq!(law.stretch_factor(Q3_29::ZERO), None);

@@ -20,7 +20,7 @@ use super::dahl_cycle::{
 };
 use super::dahl_quadrature::{Exponent, Grid, integrate_stretch};
 use super::dahl_relax::RelaxLaw;
-use super::scaled::fx_error;
+use super::fx_error;
 use super::{FrictionModel, ModelError, OperatingPoint};
 
 /// 1 / (2 pi) in Q.31.
@@ -157,7 +157,6 @@ impl FrictionModel for DahlModel {
 mod tests {
     use super::*;
     use crate::fx::{Q8_24, Q16_16};
-    use crate::model::wide;
     use core::f64::consts::{FRAC_2_PI, PI};
 
     fn relax_f64(g0: f64, y: f64, alpha: f64) -> f64 {
@@ -226,10 +225,10 @@ mod tests {
         let drive = DahlDrive {
             velocity_ratio: crate::model::littmann::VelocityRatio::Finite {
                 negative: false,
-                magnitude: wide::from_f64(zeta, "zeta").unwrap(),
+                magnitude: crate::model::scaled_from_f64(zeta, "zeta").unwrap(),
             },
             vibration_amplitude: None,
-            stiffness_amplitude: wide::from_f64(kxa, "kxa").ok(),
+            stiffness_amplitude: crate::model::scaled_from_f64(kxa, "kxa").ok(),
             travel_rate: None,
         };
         m.steady_ratio(&drive).unwrap().to_f64()

@@ -30,9 +30,9 @@ use crate::fx::{Q1_31, Q2_30, Q8_24, sin};
 use super::dahl::DahlParams;
 use super::dahl_table_nodes::{LN_SIN_33, LN_SIN_65, NODES_33, NODES_65};
 use super::littmann::{VelocityRatio, velocity_ratio};
-use super::scaled::Scaled;
-use super::wide;
 use super::{FrictionModel, Inversion, ModelError, OperatingPoint, Reach};
+use crate::fx::scaled::Scaled;
+use crate::fx::wide;
 
 /// Lower end of the table's ln(kappa x_a) axis.
 pub const LN_KXA_MIN: i32 = -8;
@@ -236,13 +236,13 @@ impl DahlTable {
         let k_t = params.tangential_stiffness;
         let omega = core::f64::consts::TAU * params.frequency_hz;
         let x_a = params.full_scale_amplitude_m;
-        let full_scale_velocity = wide::from_f64(omega * x_a, "x_a")?;
+        let full_scale_velocity = crate::model::scaled_from_f64(omega * x_a, "x_a")?;
         Ok(Self {
             grid,
             full_scale_velocity,
             inv_full_scale_velocity: wide::recip(full_scale_velocity),
-            kxa_per_load: wide::from_f64(k_t * x_a / mu, "k_t")?,
-            tau_per_load: wide::from_f64(k_t / (mu * omega), "k_t")?,
+            kxa_per_load: crate::model::scaled_from_f64(k_t * x_a / mu, "k_t")?,
+            tau_per_load: crate::model::scaled_from_f64(k_t / (mu * omega), "k_t")?,
         })
     }
 

@@ -8,8 +8,8 @@
 
 use crate::fx::{Q, Q2_30, sin_cos};
 
-use super::scaled::Scaled;
 use super::wide::{self, umul};
+use crate::fx::scaled::Scaled;
 
 /// Radians up to 8, 3.7e-9 resolution: stretch lengths and phases within a stretch.
 pub(crate) type Q4_28 = Q<28>;
@@ -187,7 +187,7 @@ mod tests {
             let z = Q2_30::from_f64(zeta).unwrap();
             let (zq, sigma) = (z.to_f64(), (1.0 - z.to_f64().powi(2)).sqrt());
             let scaled_zeta = wide::from_q(z);
-            let sigma_s = wide::from_f64(sigma, "sigma").unwrap();
+            let sigma_s = crate::model::scaled_from_f64(sigma, "sigma").unwrap();
             let phi = zq.acos();
             for bits in [
                 3i32,

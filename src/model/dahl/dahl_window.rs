@@ -21,8 +21,9 @@ use super::dahl_cycle::{Geometry, force_ratio, gap};
 use super::dahl_quadrature::{Exponent, Grid, StretchOutcome, integrate_stretch};
 use super::dahl_relax::RelaxLaw;
 use super::dahl_travel::{PI_Q28, Travel};
-use super::scaled::{Scaled, fx_error};
-use super::wide;
+use super::fx_error;
+use crate::fx::Scaled;
+use crate::fx::wide;
 
 /// Largest number of drive periods a window may span (as the reference).
 pub const MAX_WINDOW_PERIODS: f64 = 1e5;
@@ -51,7 +52,7 @@ impl DahlWindow {
                 reason: "the switch-on window is implemented for alpha = 1 (seed 003)",
             });
         }
-        let window = wide::from_f64(window_s, "Tw")?.to_f64();
+        let window = crate::model::scaled_from_f64(window_s, "Tw")?.to_f64();
         let periods = params.frequency_hz * window;
         if periods.is_nan() || periods > MAX_WINDOW_PERIODS {
             return Err(ModelError::OutOfDomain {
@@ -74,7 +75,10 @@ impl DahlWindow {
             stretch_grid: Grid::new(points / 2),
             period_grid: Grid::new(points),
             window_angle,
-            inv_window_angle: wide::from_f64(1.0 / (core::f64::consts::TAU * periods), "Tw")?,
+            inv_window_angle: crate::model::scaled_from_f64(
+                1.0 / (core::f64::consts::TAU * periods),
+                "Tw",
+            )?,
         })
     }
 

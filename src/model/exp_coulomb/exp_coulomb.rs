@@ -11,8 +11,9 @@ use crate::fx::{Q, Q2_30, Q8_24};
 
 use super::ModelError;
 use super::coulomb::friction_coefficient_q;
-use super::scaled::{Scaled, fx_error};
-use super::wide;
+use super::fx_error;
+use crate::fx::Scaled;
+use crate::fx::wide;
 
 /// Scene constants of seed 002 eq 10.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -35,7 +36,7 @@ impl ExpCoulombConstants {
         let decay = if decay_s_per_m == 0.0 {
             None
         } else {
-            Some(wide::from_f64(decay_s_per_m, "alpha_dc")?)
+            Some(crate::model::scaled_from_f64(decay_s_per_m, "alpha_dc")?)
         };
         Ok(Self {
             static_coefficient: friction_coefficient_q("mu_s", static_coefficient)?,

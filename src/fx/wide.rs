@@ -6,23 +6,33 @@
 //! runs from 1e-9 to 1e13 over the project's domain (k_t up to 1e10 N/m, x_a up to 50 um, W
 //! down to 1 mN), 1/W from 2e-5 to 1e3 1/N, velocity ratios from 0 to 1e8. These helpers carry
 //! them with 30 significant bits (relative resolution 9.3e-10) using only 32x32->64 multiplies,
-//! shifts and a count-leading-zeros: no float, no division. `fx` has no wide-range type and no
-//! fast reciprocal (its `checked_div` is a 64-bit library division, about 200 instructions);
-//! these would belong there.
+//! shifts and a count-leading-zeros: no float, no division (`Q::checked_div` is a 64-bit
+//! library division, about 200 instructions; [`recip`] is the fast reciprocal).
+//!
+//! ```
+//! use sonolube::fx::{Q16_16, wide};
+//!
+//! // A load of 3 N (Q16.16) as a wide value, its reciprocal by Newton steps, and their product.
+//! let load = wide::from_q(Q16_16::from_f64(3.0)?).expect("positive");
+//! let inverse = wide::recip(load);
+//! assert!((inverse.to_f64() - 1.0 / 3.0).abs() < 1e-9);
+//! assert!((wide::mul(load, inverse).to_f64() - 1.0).abs() < 2e-9);
+//! // Zero has no wide value: the caller handles it.
+//! assert_eq!(wide::from_q(Q16_16::ZERO), None);
+//! # Ok::<(), sonolube::fx::FxError>(())
+//! ```
 //!
 //! [`Scaled`] cannot hold zero or negative values; callers test for zero before converting
 //! ([`from_q`] returns `None`) and handle signs themselves.
 
-use crate::fx::{FxError, Q, Q2_30, Sat, ln_scaled};
-
-use super::ModelError;
-use super::scaled::Scaled;
+use super::{FxError, Q, Q2_30, Sat, ln_scaled};
+use crate::fx::scaled::Scaled;
 
 /// Mantissa bits of 1.0 in Q2.30.
-const ONE_BITS: u64 = 1 << 30;
+pub(crate) const ONE_BITS: u64 = 1 << 30;
 
 /// Builds a [`Scaled`] from raw mantissa bits in `[2^30, 2^31)` and an exponent.
-const fn make(mantissa_bits: u64, exp2: i32) -> Scaled {
+pub(crate) const fn make(mantissa_bits: u64, exp2: i32) -> Scaled {
     Scaled {
         mantissa: Q2_30::from_bits(mantissa_bits as i32),
         exp2,
@@ -44,27 +54,6 @@ fn normalise(wide: u64, shift: u32, exp2: i32) -> Scaled {
     } else {
         make(rounded, exp2)
     }
-}
-
-/// A finite, strictly positive SI value (scene load only: f64). `input` names it in the error:
-/// `NonFinite` for NaN and infinities, `OutOfDomain` for values <= 0.
-pub fn from_f64(x: f64, input: &'static str) -> Result<Scaled, ModelError> {
-    if !x.is_finite() {
-        return Err(ModelError::NonFinite { input });
-    }
-    if x <= 0.0 {
-        return Err(ModelError::OutOfDomain {
-            input,
-            reason: "must be > 0",
-        });
-    }
-    let (fraction, exponent) = libm::frexp(x); // x = fraction 2^exponent, fraction in [0.5, 1)
-    let bits = libm::round(fraction * 2_147_483_648.0) as u64; // [2^30, 2^31]
-    Ok(if bits >> 31 != 0 {
-        make(ONE_BITS, exponent)
-    } else {
-        make(bits, exponent - 1)
-    })
 }
 
 /// The value of a positive `q`, exactly (`None` for `q <= 0`). Cost: a CLZ and a shift.
@@ -301,6 +290,7 @@ pub fn ln<const OUT: u32>(a: Scaled) -> Result<Q<OUT>, FxError> {
 mod tests {
     use super::*;
     use crate::fx::{Q1_31, Q8_24, Q16_16};
+    use crate::model::{ModelError, scaled_from_f64 as from_f64};
     use proptest::prelude::*;
 
     fn s(x: f64) -> Scaled {

@@ -7,9 +7,7 @@
 //! [`Scaled::from_ln`] turns such a logarithm back into a value with 30 significant bits without
 //! any float: one exact range reduction by ln 2 and one `exp`.
 
-use crate::fx::{FxError, Q, Q1_31, Q2_30};
-
-use super::ModelError;
+use super::{Q, Q1_31, Q2_30};
 
 /// round(ln 2 * 2^40) (ln 2 * 2^40 = 762123384786.43).
 const LN2_Q40: i64 = 762_123_384_786;
@@ -92,18 +90,6 @@ impl Scaled {
     /// The value as f64, exactly (tool level and telemetry only, never in the control step).
     pub fn to_f64(self) -> f64 {
         libm::scalbn(self.mantissa.to_f64(), self.exp2)
-    }
-}
-
-/// Maps an [`FxError`] of a fixed-point step to the [`ModelError`] naming `quantity`.
-pub(crate) fn fx_error(quantity: &'static str) -> impl Fn(FxError) -> ModelError {
-    move |error| match error {
-        FxError::Overflow => ModelError::Overflow { quantity },
-        FxError::NotFinite => ModelError::NonFinite { input: quantity },
-        FxError::DivisionByZero | FxError::Domain => ModelError::OutOfDomain {
-            input: quantity,
-            reason: "outside the domain of a fixed-point function (ln of 0, division by 0)",
-        },
     }
 }
 
