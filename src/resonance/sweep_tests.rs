@@ -193,7 +193,12 @@ fn a_sweep_ends_two_points_past_a_halved_peak_with_the_same_peak() {
             let (full, all, t_full) = run(whole, &mut plant.clone());
             let (short, some, t_short) = run(early, &mut plant);
             // Two points after the best, the last of them at most half of it.
-            assert!(some.len() < all.len(), "{f0}: {} of {}", some.len(), all.len());
+            assert!(
+                some.len() < all.len(),
+                "{f0}: {} of {}",
+                some.len(),
+                all.len()
+            );
             assert_eq!(usize::from(short.best_index) + 3, some.len(), "{f0}");
             let last = some.last().unwrap().conductance.to_bits();
             assert!(2 * i64::from(last) <= i64::from(short.best.conductance.to_bits()));
