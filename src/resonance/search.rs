@@ -51,6 +51,9 @@ pub struct SearchSettings {
     pub settle_windows: u16,
     /// Lock-in windows averaged at each coarse point, >= 1.
     pub measure_windows: u16,
+    /// End the coarse sweep this many points past its best point once the conductance has
+    /// fallen to half the best ([`SweepPlan::stop_past_peak`]); 0 sweeps the whole band.
+    pub stop_past_peak: u16,
     /// The pull-in loop; its frequency limits are replaced by the band.
     pub pull_in: TrackerSettings,
     /// Longest pull-in before [`ResonanceFault::PullInTimeout`], s, > 0.
@@ -60,7 +63,8 @@ pub struct SearchSettings {
 impl SearchSettings {
     /// A search for `stack` over f0 `(1 +- relative_band)` (clamped to 20-60 kHz) at a tenth
     /// of full amplitude, coarse points one bandwidth apart (`1 / Q`), one window settled and
-    /// one measured per point, pull-in with [`TrackerSettings::PULL_IN`] for at most 6 ms.
+    /// one measured per point, ending two points past the conductance's peak once it has
+    /// halved, pull-in with [`TrackerSettings::PULL_IN`] for at most 6 ms.
     pub fn around(stack: &StackSettings, relative_band: f64) -> Self {
         let f0 = stack.resonance_hz;
         Self {
@@ -70,6 +74,7 @@ impl SearchSettings {
             relative_step: 1.0 / stack.quality_factor,
             settle_windows: 1,
             measure_windows: 1,
+            stop_past_peak: 2,
             pull_in: TrackerSettings::PULL_IN,
             pull_in_timeout_s: 6e-3,
         }
@@ -136,6 +141,9 @@ impl SearchConfig {
             points: points as u16,
             settle_windows: s.settle_windows,
             measure_windows: s.measure_windows,
+            stop_past_peak: s.stop_past_peak,
+            start_up: overrun.min(f64::from(u16::MAX)) as u16,
+            min_peak: model.min_current(amplitude),
         };
         // Lock must hold for one envelope time constant: a lagging motional phase can pass
         // through zero while the frequency is still overshooting.

@@ -44,6 +44,18 @@ pub struct SweepPlan {
     pub settle_windows: u16,
     /// Lock-in windows averaged per point (>= 1).
     pub measure_windows: u16,
+    /// Ends the sweep early once this many points have followed the best one and the latest
+    /// conductance is at most half the best (the peak is behind: a resonance's conductance
+    /// falls to a fifth one bandwidth away); 0 sweeps every point. The first such peak wins,
+    /// not the largest in the band. Only a best point whose conductance is at least
+    /// `min_peak` and that comes after the first `start_up` points ends it (a resonance, not
+    /// noise or the envelope's start-up transient).
+    pub stop_past_peak: u16,
+    /// Points at the start of the sweep (one envelope time constant) whose best never ends
+    /// the sweep early.
+    pub start_up: u16,
+    /// The least conductance a peak that ends the sweep early has (Q2.30 full scale).
+    pub min_peak: Q2_30,
 }
 
 /// The conductance at one point.
@@ -163,8 +175,16 @@ impl Sweep {
             + ((u64::from(self.planned_mhz) * u64::from(self.plan.relative_step_q32) + (1 << 31))
                 >> 32);
         let next = Frequency::from_millihertz(u32::try_from(next).unwrap_or(u32::MAX));
+        let past = self.index - 1 - self.best_index;
+        let peak_behind = self.plan.stop_past_peak > 0
+            && self.best_index > 0
+            && self.best_index >= self.plan.start_up
+            && self.best.conductance >= self.plan.min_peak
+            && past >= self.plan.stop_past_peak
+            && i64::from(point.conductance.to_bits()) * 2
+                <= i64::from(self.best.conductance.to_bits());
         match Tuning::nearest(next, self.clock) {
-            Ok(tuning) if self.index < self.plan.points => {
+            Ok(tuning) if self.index < self.plan.points && !peak_behind => {
                 self.planned_mhz = next.millihertz();
                 self.tuning = tuning;
                 self.windows = 0;

@@ -12,6 +12,9 @@ fn plan(start_hz: u32, relative_step: f64, points: u16, settle: u16, measure: u1
         points,
         settle_windows: settle,
         measure_windows: measure,
+        stop_past_peak: 0,
+        start_up: 0,
+        min_peak: Q2_30::ZERO,
     }
 }
 
@@ -172,4 +175,60 @@ fn points_the_timer_cannot_make_end_the_sweep() {
         panic!("{progress:?}");
     };
     assert_eq!(result.points, 2);
+}
+
+#[test]
+fn a_sweep_ends_two_points_past_a_halved_peak_with_the_same_peak() {
+    for f0 in [38_123.0, 40_000.0] {
+        for dynamics in [Dynamics::InstantPhase, Dynamics::Lagged] {
+            let whole = plan(36_000, 0.01, 21, 32, 2);
+            let early = SweepPlan {
+                stop_past_peak: 2,
+                start_up: 1,
+                min_peak: Q2_30::from_ratio(1, 1000).unwrap(),
+                ..whole
+            };
+            let mut plant = Resonator::reference(dynamics);
+            plant.f0_hz = f0;
+            let (full, all, t_full) = run(whole, &mut plant.clone());
+            let (short, some, t_short) = run(early, &mut plant);
+            // Two points after the best, the last of them at most half of it.
+            assert!(
+                some.len() < all.len(),
+                "{f0}: {} of {}",
+                some.len(),
+                all.len()
+            );
+            assert_eq!(usize::from(short.best_index) + 3, some.len(), "{f0}");
+            let last = some.last().unwrap().conductance.to_bits();
+            assert!(2 * i64::from(last) <= i64::from(short.best.conductance.to_bits()));
+            // The same points up to there, so the same peak.
+            assert_eq!(some[..], all[..some.len()], "{dynamics:?} {f0}");
+            assert_eq!(short.peak, full.peak, "{dynamics:?} {f0}");
+            assert!(t_short < t_full);
+        }
+    }
+}
+
+#[test]
+fn no_early_end_on_a_start_up_point_or_a_peak_below_the_threshold() {
+    let mut plant = Resonator::reference(Dynamics::Lagged);
+    plant.f0_hz = 40_000.0;
+    let whole = plan(36_000, 0.01, 21, 32, 2);
+    // The peak (point 10 or so) inside the start-up points: the whole sweep.
+    let start_up = SweepPlan {
+        stop_past_peak: 2,
+        start_up: 15,
+        ..whole
+    };
+    let (_, points, _) = run(start_up, &mut plant.clone());
+    assert_eq!(points.len(), 21);
+    // A threshold above the resonance's conductance: the whole sweep.
+    let threshold = SweepPlan {
+        stop_past_peak: 2,
+        min_peak: Q2_30::ONE,
+        ..whole
+    };
+    let (_, points, _) = run(threshold, &mut plant);
+    assert_eq!(points.len(), 21);
 }
