@@ -60,7 +60,7 @@ pub struct Settings {
     pub response_time_constant_s: f64,
     /// Time constant of the tangential load cell's own first-order lag (its amplifier), s;
     /// 0 for none. The prediction passes the same lag as the measurement
-    /// ([`crate::control::tuning`] says why it is not lumped into the envelope).
+    /// (`tuning.rs` says why it is not lumped into the envelope).
     pub sensor_lag_s: f64,
     /// Slew limit: time to change the command by full scale, s.
     pub slew_full_scale_s: f64,
