@@ -83,7 +83,10 @@ pub const STEADY_GAINS: (f64, f64) = (0.1, 300.0);
 /// what the scene fixes: the control period, the actuator ratings at the drive frequency, the
 /// controller's natural coefficient as the prior of mu0, plausible ranges of the readings
 /// (1.1 x each cell's full scale, twice the fastest sliding speed but at least 5 m/s), the
-/// transducer's envelope time constant and the tangential cell's lag. The fast gains, the
+/// no-load guard (half the lightest load of the scene's contents, at most the baseline's
+/// 0.5 N: at 0.5 N the baseline's guard judged the loaded contact unloaded on many samples and
+/// the loop never ran), the transducer's envelope time constant and the tangential cell's lag.
+/// The fast gains, the
 /// boost, the lead, the slew and the ramps keep their reference values.
 ///
 /// **The envelope is the transducer's; the cell's lag is a stage of its own.** The PI compares
@@ -125,6 +128,12 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
         velocity_bandwidth_hz: libm::fmin(VELOCITY_FILTER_HZ, 0.1 / scene.control_period_s()),
         normal_force_range_n: force_range(&scene.normal_cell),
         tangential_force_range_n: force_range(&scene.tangential_cell),
+        // Half the lightest load the scene declares, at most the baseline's 0.5 N: the guard
+        // must sit below every load the scene runs at, or a loaded contact reads as unloaded.
+        min_normal_force_n: libm::fmin(
+            reference.min_normal_force_n,
+            0.5 * scene.contents.load_min_n,
+        ),
         velocity_range_m_s: libm::fmin(
             libm::fmax(reference.velocity_range_m_s, 2.0 * top_speed),
             120.0,
@@ -166,6 +175,16 @@ mod tests {
         assert!((s.sensor_lag_s - 0.000_079_6).abs() < 1e-7);
         assert_eq!(s.velocity_bandwidth_hz, VELOCITY_FILTER_HZ);
         assert_eq!(s.natural_learn_s, NATURAL_LEARN_S);
+        // The no-load guard: the baseline's 0.5 N, below half the scene's 4.155 N.
+        assert_eq!(s.min_normal_force_n, 0.5);
+        let light = crate::scene::Scene {
+            contents: crate::scene::Contents {
+                load_min_n: 0.5,
+                ..scene.contents
+            },
+            ..*scene
+        };
+        assert_eq!(controller_settings(&light).min_normal_force_n, 0.25);
         assert_eq!(
             (s.normal_bandwidth_hz, s.tangential_bandwidth_hz),
             (FORCE_FILTER_HZ, FORCE_FILTER_HZ)
