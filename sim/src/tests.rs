@@ -45,10 +45,13 @@ fn a_run_takes_the_scenes_steps_and_applies_its_target_at_its_time() {
     // The step at 5 ms is the 50th sample's target, and the controller holds it from there.
     assert_eq!((run[48].target, run[49].target), (natural, half));
     assert_eq!(sim.controller().target(), half);
-    // Started at t = 0: running once the sliding is confirmed (1 ms), drive off until the step.
-    assert!(run[..9].iter().all(|r| r.state == SupervisorState::Idle));
+    // Started at t = 0: running once the sliding is confirmed (1 ms) and mu0 has been learned
+    // for 3 ms (`natural_learn_s`), drive off until the step.
+    let first_running = run.iter().position(|r| r.state == SupervisorState::Running);
+    assert!(matches!(first_running, Some(37..=40)), "{first_running:?}");
+    assert!(run[..37].iter().all(|r| r.state == SupervisorState::Idle));
     assert!(
-        run[20..49]
+        run[40..49]
             .iter()
             .all(|r| r.state == SupervisorState::Running)
     );

@@ -44,10 +44,13 @@ pub struct Settings {
     pub sliding_debounce_s: f64,
     /// The scene's friction coefficient, the prior of the natural friction.
     pub natural_prior: f64,
-    /// How many samples the prior is worth.
+    /// How many samples the prior is worth; 0: the first sample learned replaces it.
     pub natural_prior_weight: u32,
     /// Averaging window of the natural friction once learned, s.
     pub natural_window_s: f64,
+    /// Least time the natural friction is learned (sliding, loaded, drive off) before a run's
+    /// drive may start, s; 0 to start at once. Capped at the averaging window.
+    pub natural_learn_s: f64,
     /// Estimated vibration amplitude below which the drive counts as off for learning,
     /// fraction of full scale.
     pub natural_max_drive: f64,
@@ -55,6 +58,10 @@ pub struct Settings {
     pub envelope_time_constant_s: f64,
     /// Time constant the lead gives the envelope, s (<= the envelope's).
     pub response_time_constant_s: f64,
+    /// Time constant of the tangential load cell's own first-order lag (its amplifier), s;
+    /// 0 for none. The prediction passes the same lag as the measurement
+    /// (`tuning.rs` says why it is not lumped into the envelope).
+    pub sensor_lag_s: f64,
     /// Slew limit: time to change the command by full scale, s.
     pub slew_full_scale_s: f64,
     /// Soft start: time for the ceiling to rise by full scale, s.
@@ -100,9 +107,11 @@ impl Settings {
         natural_prior: 0.3,
         natural_prior_weight: 4,
         natural_window_s: 0.2,
+        natural_learn_s: 0.0,
         natural_max_drive: 1e-3,
         envelope_time_constant_s: 0.8e-3,
         response_time_constant_s: 0.25e-3,
+        sensor_lag_s: 0.0,
         slew_full_scale_s: 0.5e-3,
         ramp_up_full_scale_s: 5e-3,
         ramp_down_full_scale_s: 5e-3,
@@ -166,8 +175,13 @@ pub struct Config {
     pub(super) ranges: SensorRanges,
     pub(super) sliding: SlidingConfig,
     pub(super) natural: NaturalConfig,
+    /// The natural friction's weight (prior plus samples learned) from which a run may
+    /// start: `prior_weight` plus the samples of `natural_learn_s`, at most the window.
+    pub(super) natural_ready: u32,
     pub(super) natural_max_drive: Q1_31,
     pub(super) shaper: ShaperConfig,
+    /// The tangential cell's lag, applied to the prediction; `None` without one.
+    pub(super) sensor_lag: Option<LowPassCoef>,
     pub(super) ramp: RampConfig,
     pub(super) gains: GainSchedule,
     pub(super) limit: AmplitudeLimit,
@@ -225,9 +239,17 @@ impl Config {
         let prior = Q2_30::from_f64(prior).map_err(|_| ConfigError::OutOfRange {
             setting: "natural_prior",
         })?;
-        let prior_weight = s.natural_prior_weight.max(1);
+        let prior_weight = s.natural_prior_weight;
         let window =
             steps(positive(s.natural_window_s, "natural_window_s")?, period).max(prior_weight);
+        let learn = s.natural_learn_s;
+        if !(learn.is_finite() && learn >= 0.0) {
+            return Err(ConfigError::OutOfRange {
+                setting: "natural_learn_s",
+            });
+        }
+        let learn_steps = libm::round(learn / period).min(u32::MAX as f64) as u32;
+        let natural_ready = prior_weight.saturating_add(learn_steps).min(window);
         let debounce = s.sliding_debounce_s;
         if !(debounce.is_finite() && debounce >= 0.0) {
             return Err(ConfigError::OutOfRange {
@@ -257,6 +279,7 @@ impl Config {
                 prior_weight,
                 window,
             },
+            natural_ready,
             natural_max_drive: fraction(s.natural_max_drive, "natural_max_drive")?,
             shaper: ShaperConfig::new(
                 s.envelope_time_constant_s,
@@ -265,6 +288,15 @@ impl Config {
                 period,
             )
             .map_err(ConfigError::Shaper)?,
+            sensor_lag: if s.sensor_lag_s == 0.0 {
+                None
+            } else {
+                let lag = LowPassCoef::from_time_constant(s.sensor_lag_s, period);
+                Some(lag.map_err(|error| ConfigError::Filter {
+                    setting: "sensor_lag_s",
+                    error,
+                })?)
+            },
             ramp: RampConfig {
                 up_step: step(s.ramp_up_full_scale_s, "ramp_up_full_scale_s")?,
                 down_step: step(s.ramp_down_full_scale_s, "ramp_down_full_scale_s")?,

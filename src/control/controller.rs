@@ -72,6 +72,8 @@ pub struct ControllerState {
     boost: Boost,
     gains: PiGains,
     prediction: LowPass<30>,
+    /// The prediction through the tangential cell's lag, before `prediction`'s filter.
+    sensed_prediction: LowPass<30>,
     prediction_valid: bool,
     /// The last model inversion's amplitude (Q1.31 fraction of full scale, [0, 1)): where
     /// the next inversion starts ([`FrictionModel::invert_from`]); zero from each ramp-up.
@@ -121,6 +123,7 @@ impl Controller {
                 boost: Boost::new(),
                 gains: config.gains.slow(),
                 prediction: LowPass::new(Q2_30::ONE),
+                sensed_prediction: LowPass::new(Q2_30::ONE),
                 prediction_valid: false,
                 feedforward: Q1_31::ZERO,
                 target: None,
@@ -211,6 +214,10 @@ impl Controller {
         if s.contact == Contact::Ok && drive_off && s.supervisor.state() != SupervisorState::Fault {
             s.natural.learn(&c.natural, s.estimate.coefficient);
         }
+        if s.contact == Contact::Ok && s.natural.weight() < c.natural_ready {
+            // A reduction is relative to mu0: no run starts on a mu0 worth a few samples.
+            s.contact = Contact::Learning;
+        }
         s.supervisor.follow_contact(s.contact, s.shaper.command());
     }
 
@@ -284,9 +291,14 @@ impl Controller {
             if !s.prediction_valid {
                 let seed = measured.saturating_add(s.pi.correction()).value;
                 s.prediction.reset(seed);
+                s.sensed_prediction.reset(seed);
                 s.prediction_valid = true;
             }
-            let predicted = s.prediction.update(&c.estimator.tangential, predicted_now);
+            let sensed = match &c.sensor_lag {
+                Some(lag) => s.sensed_prediction.update(lag, predicted_now),
+                None => predicted_now,
+            };
+            let predicted = s.prediction.update(&c.estimator.tangential, sensed);
             let reference = predicted.saturating_sub(s.pi.correction()).value;
             let error = reference.saturating_sub(measured).value;
             // This step's gains on the schedule; the change from the last step is bumpless.

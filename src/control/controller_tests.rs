@@ -511,3 +511,86 @@ fn the_coulomb_load_is_exact_at_its_extremes_and_refuses_what_does_not_fit() {
         Err(ModelError::OutOfDomain { .. })
     ));
 }
+
+#[test]
+fn the_drive_waits_until_the_natural_friction_is_learned_for_natural_learn_s() {
+    // Debounce 2 ms (20 steps), then 3 ms (30 samples) of learning before the drive may start.
+    let settings = Settings {
+        natural_learn_s: 3e-3,
+        ..Settings::REFERENCE
+    };
+    let mut ctl = Controller::new(Config::new(&settings).unwrap());
+    let model = LittmannModel::new(0.0754);
+    let mut plant = Plant::new(0.3, 0.0754 * 0.9, 0.8e-3, T, 3);
+    ctl.set_target(HALF).unwrap();
+    // Started before sliding is confirmed: armed, idle.
+    ctl.start().unwrap();
+    let mut first_drive = None;
+    for k in 1..=200 {
+        let out = run(&mut ctl, &model, &mut plant, 1);
+        if first_drive.is_none() && out.amplitude > Q1_31::ZERO {
+            first_drive = Some((k, out.reason));
+        }
+    }
+    let (k, reason) = first_drive.expect("the run starts once mu0 is learned");
+    // Sliding is confirmed at step 20 or 21; 30 samples later the ramp-up begins.
+    assert!((49..=52).contains(&k), "first drive at step {k}");
+    assert_eq!(reason, Reason::SlidingResumed);
+    // Without the wait the drive starts as soon as sliding is confirmed.
+    let (mut ctl, model, mut plant) = setup();
+    ctl.set_target(HALF).unwrap();
+    ctl.start().unwrap();
+    let first = (1..=200).find(|_| run(&mut ctl, &model, &mut plant, 1).amplitude > Q1_31::ZERO);
+    assert!(matches!(first, Some(20..=22)), "{first:?}");
+}
+
+#[test]
+fn a_run_going_on_is_not_stopped_by_a_natural_friction_learned_afresh() {
+    let (mut ctl, model, mut plant) = running();
+    // A new prior restarts the learning; the drive is on, so nothing is learned, and the run
+    // must go on rather than wait.
+    let settings = Settings {
+        natural_prior: 0.25,
+        natural_learn_s: 3e-3,
+        ..Settings::REFERENCE
+    };
+    ctl.reconfigure(Config::new(&settings).unwrap());
+    let out = run(&mut ctl, &model, &mut plant, 100);
+    assert_eq!(out.state, S::Running);
+    assert!(out.amplitude.to_f64() > 0.3);
+}
+
+#[test]
+fn bad_sensor_lag_and_learning_times_are_named() {
+    let r = Settings::REFERENCE;
+    for lag in [-1e-4, f64::NAN] {
+        assert!(matches!(
+            Config::new(&Settings {
+                sensor_lag_s: lag,
+                ..r
+            }),
+            Err(super::config::ConfigError::Filter {
+                setting: "sensor_lag_s",
+                ..
+            })
+        ));
+    }
+    for learn in [-1e-3, f64::INFINITY, f64::NAN] {
+        assert_eq!(
+            Config::new(&Settings {
+                natural_learn_s: learn,
+                ..r
+            }),
+            Err(super::config::ConfigError::OutOfRange {
+                setting: "natural_learn_s"
+            })
+        );
+    }
+    assert!(
+        Config::new(&Settings {
+            sensor_lag_s: 79.6e-6,
+            ..r
+        })
+        .is_ok()
+    );
+}

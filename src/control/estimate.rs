@@ -132,7 +132,7 @@ impl Default for FrictionEstimator {
 pub struct NaturalConfig {
     /// The scene's friction coefficient, the starting value, Q2.30 in [1e-3, 2).
     pub prior: Q2_30,
-    /// How many samples the prior is worth (>= 1).
+    /// How many samples the prior is worth (0: the first sample learned replaces it).
     pub prior_weight: u32,
     /// Length of the averaging window once learned, samples (>= `prior_weight`).
     pub window: u32,
@@ -153,7 +153,7 @@ impl NaturalFriction {
         let coefficient = config.prior.max(MIN_NATURAL_COEF);
         Self {
             coefficient,
-            weight: config.prior_weight.max(1),
+            weight: config.prior_weight,
             reciprocal: Reciprocal::of(coefficient).unwrap_or(Reciprocal::ONE),
         }
     }

@@ -8,7 +8,7 @@
 //!  F_n, F_t, v ──> estimate ──> mu, F_n, v ──┬──> target ratio r_t (target.rs)
 //!  (Q16.16, Q8.24)  (filters, guard)         │
 //!                                            │  measured ratio r_m = mu / mu0
-//!  model.ratio(point, a_env) ─> r̂ ─> same filter as F_t ─> r̂_f
+//!  model.ratio(point, a_env) ─> r̂ ─> cell lag ─> same filter as F_t ─> r̂_f
 //!  PI error e = (r̂_f - c) - r_m ──> PI (fast→slow gains) ──> correction c
 //!  model.invert(point, r_t + c) ──> feedforward amplitude ──> actuator ceiling
 //!   ──> lead (envelope-lag compensation) ──> slew ──> ceiling ──> drive command u
@@ -39,16 +39,18 @@
 //!
 //! First-order low-passes (filter.rs, exactly -3 dB at the stated frequency): **both forces
 //! 250 Hz** ([`FORCE_FILTER_HZ`]: equal filters make `F_t / F_n` follow a load change exactly;
-//! the prediction passes the same filter) and **velocity 200 Hz**. `mu = |F_t| / F_n`, with
-//! `F_n` guarded at `F_n_min` (0.5 N): below it the contact counts as unloaded. `mu0` starts at
-//! the scene's `mu`, worth one sample ([`NATURAL_PRIOR_WEIGHT`]), and is learned (running
-//! mean, then a 0.2 s window) only while sliding with the drive off, e.g. before a start or
-//! while the target is natural friction. Sliding: hysteresis 1 / 0.5 mm/s and a 1 ms debounce
-//! ([`SLIDING_DEBOUNCE_S`]).
+//! the prediction passes the same filter) and **velocity 1 kHz** ([`VELOCITY_FILTER_HZ`]).
+//! `mu = |F_t| / F_n`, with `F_n` guarded at `F_n_min` (0.5 N): below it the contact counts as
+//! unloaded. `mu0` starts at the scene's `mu`, worth no sample ([`NATURAL_PRIOR_WEIGHT`]: the
+//! first sample replaces it), and is learned (running mean, then a 0.2 s window) only while
+//! sliding with the drive off, e.g. before a start or while the target is natural friction; a
+//! run's drive starts only after 3 ms of it ([`NATURAL_LEARN_S`]). Sliding: hysteresis 1 /
+//! 0.5 mm/s and a 1 ms debounce ([`SLIDING_DEBOUNCE_S`]).
 //!
 //! The tuning every scene and board runs is [`controller_settings`] (why each value:
 //! `tuning.rs`). It starts from [`Settings::REFERENCE`], a baseline with a 200 Hz normal and an
-//! 800 Hz tangential filter, prior weight 4, a 2 ms debounce and steady gains kp 0 / ki 150 /s;
+//! 800 Hz tangential filter, a 200 Hz speed filter, prior weight 4, a 2 ms debounce, no wait
+//! for mu0, no cell lag in the prediction and steady gains kp 0 / ki 150 /s;
 //! the controller's unit tests against the test plant (and "Numbers" below) run that baseline.
 //!
 //! # Feedforward, reference and PI (pi.rs, schedule.rs)
@@ -59,8 +61,9 @@
 //! infinite slope at its edge, where an amplitude-domain PI would be useless or unstable).
 //!
 //! The PI does not compare the measurement with the target but with what the model predicts the
-//! cells read *now*: `r̂ = model.ratio(point, a_env)` at the estimated actual envelope, passed
-//! through the tangential filter, minus the present correction. At steady state that is the
+//! cells read *now*: `r̂ = model.ratio(point, a_env)` at the estimated actual envelope (the
+//! transducer's time constant), passed through the tangential cell's own lag and the
+//! tangential filter, as the measurement is, minus the present correction. At steady state that is the
 //! target (`r̂ = r_t + c`), so `e = r_t - r_m` there and the integral removes every static
 //! error; during a transient, the envelope lag, the filter lag, the slew limit, the soft start
 //! and the saturations are all inside the prediction, so the error is only the model mismatch
@@ -152,5 +155,6 @@ pub use sliding::{SlidingConfig, SlidingDetector};
 pub use supervisor::{Contact, RampConfig, Supervisor};
 pub use target::{ForceQ, PreparedTarget};
 pub use tuning::{
-    FORCE_FILTER_HZ, NATURAL_PRIOR_WEIGHT, SLIDING_DEBOUNCE_S, STEADY_GAINS, controller_settings,
+    FORCE_FILTER_HZ, NATURAL_LEARN_S, NATURAL_PRIOR_WEIGHT, SLIDING_DEBOUNCE_S, STEADY_GAINS,
+    VELOCITY_FILTER_HZ, controller_settings,
 };

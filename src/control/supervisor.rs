@@ -11,8 +11,9 @@
 //!    └── clear ── fault <── any state: sensor fault, overcurrent, overrun, model error
 //! ```
 //!
-//! - `start` arms the run. With sliding contact the soft start begins at once; without it the
-//!   supervisor stays idle, armed, and starts by itself when the contact comes back
+//! - `start` arms the run. With sliding contact, loaded, whose natural friction has been
+//!   learned, the soft start begins at once; otherwise the supervisor stays idle, armed, and
+//!   starts by itself when the contact comes back and the natural friction is learned
 //!   (`sliding-resumed`). Losing sliding or load while running ramps down and keeps the run
 //!   armed (`not-sliding`, `no-load`): no sliding, no friction reduction to control, so the
 //!   drive goes to its safe idle level, zero, and the state and reason say why.
@@ -50,6 +51,10 @@ pub enum Contact {
     NotSliding,
     /// Sliding but the normal force is below its minimum.
     NoLoad,
+    /// Sliding with load, but the natural friction has not been learned long enough for a
+    /// run to start (the drive stays off and the learning goes on); a run already going on
+    /// is not affected.
+    Learning,
 }
 
 /// The supervisor's state.
