@@ -370,6 +370,9 @@ mod tests {
     #[test]
     fn reference_settings_make_a_config() {
         let c = Config::new(&Settings::REFERENCE).unwrap();
+        // The period the config reports is the one it was built for (10 kHz).
+        assert_eq!(c.period_s(), Settings::REFERENCE.period_s);
+        assert_eq!(c.period_s(), 1e-4);
         assert_eq!(c.sliding.debounce_steps, 20);
         assert_eq!(c.natural.window, 2_000);
         assert!((c.ramp.up_step.to_f64() - 0.02).abs() < 1e-9);

@@ -104,6 +104,29 @@ mod tests {
     use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
     use proptest::prelude::*;
 
+    /// A quotient that lands on the largest value of its format is in range, not clamped:
+    /// 1 / (1 + 2^-30) into Q1.31 (from an integer 1: the product of the value and the
+    /// mantissa, 2^31 - 1, is used unshifted) is 1 - 2^-31 = `Q1_31::MAX`, exact, and -1 over
+    /// it is -(1 - 2^-31), exact; 2 / (1 + 2^-30) does not fit Q1.31 and is flagged.
+    #[test]
+    fn a_quotient_at_the_top_of_its_format_is_exact() {
+        let x = Q2_30::from_bits((1 << 30) + 1);
+        let r = Reciprocal::of(x).unwrap();
+        let one = Q::<0>::from_bits(1);
+        assert_eq!(r.times::<0, 31>(one), Sat::exact(Q1_31::MAX));
+        assert_eq!(
+            r.times::<0, 31>(Q::<0>::from_bits(-1)),
+            Sat::exact(Q1_31::from_bits(-i32::MAX))
+        );
+        assert_eq!(
+            r.times::<0, 31>(Q::<0>::from_bits(2)),
+            Sat::clamped(Q1_31::MAX)
+        );
+        // The true quotient is 1 - 2^-30 + 2^-60: the result is within 1 ulp of Q1.31.
+        let q = r.times::<0, 31>(one).value.to_f64();
+        assert!((q - 1.0 / x.to_f64()).abs() <= 2f64.powi(-31));
+    }
+
     fn relative_error<const F: u32>(x: Q<F>) -> f64 {
         let r = Reciprocal::of(x).unwrap();
         let approx = r.mantissa as f64 * 2f64.powi(r.exponent as i32 - 62);

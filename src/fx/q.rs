@@ -185,6 +185,20 @@ mod tests {
         assert!((Q8_24::LN_10.to_f64() - core::f64::consts::LN_10).abs() <= 0.5 / 16777216.0);
     }
 
+    /// The sign predicates are strict: zero is neither positive nor negative, one unit
+    /// either side of it is (a `>=` or `<=` here makes zero count as a sign, so that a zero
+    /// load or amplitude would pass the models' "positive" guards).
+    #[test]
+    fn zero_has_no_sign_and_one_unit_does() {
+        assert!(!Q16_16::ZERO.is_positive());
+        assert!(!Q16_16::ZERO.is_negative());
+        assert!(Q16_16::from_bits(1).is_positive());
+        assert!(!Q16_16::from_bits(1).is_negative());
+        assert!(Q16_16::from_bits(-1).is_negative());
+        assert!(!Q16_16::from_bits(-1).is_positive());
+        assert!(Q2_30::MAX.is_positive() && Q2_30::MIN.is_negative());
+    }
+
     #[test]
     fn formatting_shows_format_and_value() {
         let x = Q16_16::from_f64(-1.25).unwrap();

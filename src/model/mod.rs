@@ -298,3 +298,34 @@ pub(crate) fn fx_error(quantity: &'static str) -> impl Fn(FxError) -> ModelError
         },
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::ModelError;
+
+    /// Each error's text is a sentence that names the input or quantity at fault, and the
+    /// bound it breaks.
+    #[test]
+    fn model_errors_name_what_is_wrong() {
+        let cases = [
+            (
+                ModelError::NonFinite { input: "F_n" },
+                "input F_n is not a finite number",
+            ),
+            (
+                ModelError::OutOfDomain {
+                    input: "v",
+                    reason: "must be below 128 m/s",
+                },
+                "input v is out of domain: must be below 128 m/s",
+            ),
+            (
+                ModelError::Overflow { quantity: "K_t" },
+                "K_t does not fit its fixed-point format",
+            ),
+        ];
+        for (error, text) in cases {
+            assert_eq!(format!("{error}"), text);
+        }
+    }
+}

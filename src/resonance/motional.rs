@@ -139,6 +139,29 @@ mod tests {
     use super::*;
     use std::f64::consts::TAU;
 
+    /// The detuning -Im/Re is rounded to nearest Q8.24 on both sides of resonance, and is odd
+    /// in the quadrature: below resonance (Im > 0) it is exactly the negative of above.
+    #[test]
+    fn detuning_is_rounded_to_nearest_on_both_sides() {
+        let q = |bits: i32| Q2_30::from_bits(bits);
+        for (re, im) in [
+            (1 << 30, 1 << 29),
+            (1 << 30, 3),
+            (123_456_789, 98_765_432),
+            (1 << 20, 7 << 20),
+            (1_000_003, 1),
+        ] {
+            let want = f64::from(im) / f64::from(re) * 16_777_216.0;
+            let below = detuning(Phasor::new(q(re), q(im))).to_bits();
+            let above = detuning(Phasor::new(q(re), q(-im))).to_bits();
+            assert!(
+                (f64::from(above) - want).abs() <= 0.5,
+                "{re} {im}: {above} vs {want}"
+            );
+            assert_eq!(below, -above, "{re} {im}");
+        }
+    }
+
     /// The reference stack (scenes/reference.toml): 300 nF, 3.1 ohm, Q 100 at 40 kHz, 5.25 V
     /// full scale, and the NUCLEO current sense's 6.6 A per full scale.
     const C0: f64 = 300e-9;

@@ -231,6 +231,27 @@ impl Phasor {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Phasors on the axes and the diagonals have exact binary angles: the CORDIC's angle
+    /// (8 extra bits) is rounded to nearest, so 0, a quarter, half and an eighth of a turn come
+    /// out exactly (a rounding that is off by half an ulp reads one ulp low everywhere).
+    #[test]
+    fn axes_and_diagonals_have_exact_angles() {
+        let h = 1 << 29;
+        for (x, y, turn) in [
+            (h, 0, 0),
+            (0, h, 1 << 30),
+            (-h, 0, i32::MIN),
+            (0, -h, -(1 << 30)),
+            (h, h, 1 << 29),
+            (-h, -h, -(3 << 29)),
+            (12_345, 0, 0),
+            (0, 77_777, 1 << 30),
+        ] {
+            let p = Phasor::new(Q2_30::from_bits(x), Q2_30::from_bits(y)).polar();
+            assert_eq!(p.phase.to_bits(), turn, "({x}, {y})");
+        }
+    }
     use proptest::prelude::*;
 
     fn q(x: f64) -> Q2_30 {

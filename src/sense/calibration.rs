@@ -192,6 +192,23 @@ mod tests {
         assert_eq!(other.apply(Q1_31::MAX), Sat::clamped(Q16_16::MIN));
     }
 
+    /// A value that lands exactly on the largest Q16.16 (32 768 N less one ulp) fits: it is
+    /// exact, not flagged as clamped; one ulp more is clamped. Offset -1 + 2^-31 and 16 384 N
+    /// per full scale: the reading 1 - 2^-31 is 2 - 2^-30 full scales above the zero, i.e.
+    /// 32 768 - 2^-16 N.
+    #[test]
+    fn a_value_on_the_top_of_q16_16_is_exact() {
+        let top = Calibration::new(Q1_31::from_bits(i32::MIN + 1), q16(16_384.0));
+        assert_eq!(top.apply(Q1_31::MAX), Sat::exact(Q16_16::MAX));
+        let above = Calibration::new(Q1_31::MIN, q16(16_384.0));
+        assert_eq!(above.apply(Q1_31::MAX), Sat::clamped(Q16_16::MAX));
+        let bottom = Calibration::new(Q1_31::ZERO, q16(16_384.0));
+        assert_eq!(
+            bottom.apply(Q1_31::MIN),
+            Sat::exact(Q16_16::from_int(-16_384).unwrap())
+        );
+    }
+
     #[test]
     fn the_inverse_finds_the_reading_of_a_value() {
         // A current sense: zero at 0.5 FS, 6.6 A per full scale.

@@ -192,4 +192,48 @@ mod tests {
         };
         assert_eq!(no_gain.calibration(), Err(SenseError::InvalidFrontEnd));
     }
+
+    /// Each of the bridge chain's five values, zero on its own, is refused (a zero
+    /// sensitivity, excitation or gain would otherwise divide by zero).
+    #[test]
+    fn each_zero_value_of_a_bridge_is_refused_alone() {
+        let cell = BridgeAmplifier {
+            rated_load_n: 222,
+            sensitivity_uv_per_v: 2000,
+            excitation_millivolt: 5000,
+            gain_milli: 150_000,
+            full_scale_microvolt: 3_300_000,
+            zero: Q1_31::ZERO,
+        };
+        assert!(cell.calibration().is_ok());
+        let zeroed = [
+            BridgeAmplifier {
+                rated_load_n: 0,
+                ..cell
+            },
+            BridgeAmplifier {
+                sensitivity_uv_per_v: 0,
+                ..cell
+            },
+            BridgeAmplifier {
+                excitation_millivolt: 0,
+                ..cell
+            },
+            BridgeAmplifier {
+                gain_milli: 0,
+                ..cell
+            },
+            BridgeAmplifier {
+                full_scale_microvolt: 0,
+                ..cell
+            },
+        ];
+        for bridge in zeroed {
+            assert_eq!(
+                bridge.calibration(),
+                Err(SenseError::InvalidFrontEnd),
+                "{bridge:?}"
+            );
+        }
+    }
 }

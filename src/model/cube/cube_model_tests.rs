@@ -87,3 +87,29 @@ fn scenes_with_an_active_u_term_fall_back_to_bisection() {
         invert(&m, &p, target, BISECTION_STEPS)
     );
 }
+
+/// A horn that does not vibrate (A = B = 0, allowed by `CubeParams`) leaves the friction at
+/// its natural value at every amplitude: W0 = 1 and its slope is 0 everywhere. A target below
+/// 1 is then out of reach: the inversion reports it at full scale, as the bisection does,
+/// instead of taking a Newton step through the zero slope.
+#[test]
+fn a_horn_that_does_not_vibrate_cannot_reduce_friction() {
+    let still = CubeParams {
+        longitudinal_amplitude: 0.0,
+        vertical_amplitude: 0.0,
+        ..test_1(0.0)
+    };
+    let m = CubeModel::new(&still, &CubeOptions::default()).unwrap();
+    let p = point(40);
+    assert_eq!(m.ratio(&p, Q1_31::MAX), Ok(Q2_30::ONE));
+    for target in [0.5, 0.9, 0.999] {
+        let target = Q2_30::from_f64(target).unwrap();
+        let inversion = m.invert(&p, target).unwrap();
+        assert_eq!(
+            (inversion.reach, inversion.amplitude, inversion.ratio),
+            (Reach::BelowMinimum, Q1_31::MAX, Q2_30::ONE),
+            "{target:?}"
+        );
+        assert_eq!(inversion.reach, invert(&m, &p, target, 24).unwrap().reach);
+    }
+}

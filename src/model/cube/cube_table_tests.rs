@@ -235,3 +235,38 @@ fn bad_sides_ranges_and_untabulable_scenes_are_errors() {
     let off = CubeModel::new(&test_1(0.02), &CubeOptions::default()).unwrap();
     assert!(CubeTable::new(off, RANGE, 9).is_err());
 }
+
+/// Where F'/F is flat over several nodes (a horn that barely vibrates: 1.1 pm, so that the
+/// ratio moves by a few Q2.30 ulps over the whole amplitude range), a target equal to the
+/// plateau's value is reached at the plateau's first node: the smallest amplitude that
+/// reaches it, not the largest.
+#[test]
+fn a_target_on_a_plateau_is_reached_at_its_smallest_amplitude() {
+    let params = crate::model::cube::CubeParams {
+        longitudinal_amplitude: 11.46e-6 * 1e-7,
+        vertical_amplitude: 1.1e-6 * 1e-7,
+        ..test_1(0.0)
+    };
+    let exact = CubeModel::new(&params, &CubeOptions::default()).unwrap();
+    let table = CubeTable::new(exact, RANGE, 17).unwrap();
+    let p = at(100.0);
+    let ratios: Vec<Q2_30> = (0..17)
+        .map(|j| table.ratio(&p, table.node_amplitude(j)).unwrap())
+        .collect();
+    let (natural, floor) = (ratios[0], ratios[16]);
+    let mut plateaus = 0;
+    for j in 1..16 {
+        let value = ratios[j];
+        if ratios[j - 1] > value && ratios[j + 1] == value && value > floor && value < natural {
+            plateaus += 1;
+            let inversion = table.invert(&p, value).unwrap();
+            assert_eq!(
+                (inversion.reach, inversion.amplitude, inversion.ratio),
+                (Reach::Reached, table.node_amplitude(j), value),
+                "plateau from node {j}: {ratios:?}"
+            );
+        }
+    }
+    // The case exists at this load (not a test that passes by finding no plateau).
+    assert!(plateaus >= 1, "{ratios:?}");
+}

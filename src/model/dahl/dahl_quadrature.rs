@@ -384,6 +384,28 @@ fn vanishing_mean(a: &Node, b: &Node, vanish_travel: Option<Scaled>, clamp_share
 mod tests {
     use super::*;
 
+    /// e^-y across the three ranges of `exp_neg_q30` and at their joins (y = 2 and 128 in
+    /// Q.30): within the resolution of the format each range uses (Q2.30 below 2; Q8.24, 64
+    /// units of Q.30, below 128) plus the `exp_neg` error, and 0 beyond.
+    #[test]
+    fn exp_neg_q30_is_e_to_the_minus_y_on_both_sides_of_each_join() {
+        let one = (1u64 << 30) as f64;
+        for (y, slack) in [
+            (0i64, 1.0),
+            (1 << 29, 1.0),
+            ((1 << 31) - 1, 1.0),
+            (1 << 31, 64.0),
+            ((1 << 31) + (1 << 20), 64.0),
+            ((1 << 37) - 64, 64.0),
+        ] {
+            let want = libm::exp(-(y as f64) / one) * one;
+            let got = exp_neg_q30(y) as f64;
+            assert!((got - want).abs() <= slack + 1.0, "y {y}: {got} vs {want}");
+        }
+        assert_eq!(exp_neg_q30(1 << 37), 0);
+        assert_eq!(exp_neg_q30(i64::MAX), 0);
+    }
+
     #[test]
     fn grid_is_monotone_and_ends_on_the_stretch() {
         for nodes in [2u32, 3, 32, 2048] {

@@ -515,6 +515,26 @@ mod tests {
         }
     }
 
+    /// The generated ln sin(pi x_i / 2) column holds, at every x node x_i = i / (S - 1) but
+    /// the unused first, the correctly rounded Q8.24 value (within half an ulp of libm's f64;
+    /// values from ln sin(pi / 128) = -3.7 at the 65-node grid's first node up to 0 at x = 1).
+    #[test]
+    fn ln_sin_columns_are_their_formula_rounded() {
+        for grid in [&GRID_33, &GRID_65] {
+            let s = grid.side;
+            assert_eq!(grid.ln_sin.len(), s);
+            assert_eq!(grid.ln_sin[0], i32::MIN);
+            for (i, &bits) in grid.ln_sin.iter().enumerate().skip(1) {
+                let x = i as f64 / (s - 1) as f64;
+                let want = libm::log(libm::sin(core::f64::consts::FRAC_PI_2 * x)) * 16_777_216.0;
+                assert!(
+                    (f64::from(bits) - want).abs() <= 0.5 + 1e-6,
+                    "{s} nodes, x_{i}: {bits} vs {want}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn interpolation_reproduces_the_nodes_and_the_limits() {
         for grid in [&GRID_33, &GRID_65] {

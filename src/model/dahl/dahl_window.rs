@@ -319,6 +319,31 @@ mod tests {
         .unwrap()
     }
 
+    /// The reduction 1 - average sgn(v) is the exact half-ulp rounding of its Q2.30 input into
+    /// Q3.29: no friction left is 1 exactly, full friction 0 exactly, reversed full friction 2,
+    /// and an odd difference rounds half up.
+    #[test]
+    fn reduction_is_one_minus_the_directed_average_rounded() {
+        let window = |average: f64, negative: bool| DahlWindowAverage::<16> {
+            average: Q2_30::from_f64(average).unwrap(),
+            average_friction: Q16_16::ZERO,
+            direction_negative: negative,
+        };
+        for (average, negative, want) in [
+            (0.0, false, 1.0),
+            (1.0 - 2f64.powi(-30), false, 2f64.powi(-30)),
+            (0.25, false, 0.75),
+            (0.25, true, 1.25),
+            (-1.0, false, 2.0),
+            (-1.0, true, 0.0),
+        ] {
+            let got = window(average, negative).reduction();
+            // want is a multiple of 2^-30: the Q3.29 value is want rounded, ties up.
+            let bits = libm::floor(want * 2f64.powi(29) + 0.5) as i32;
+            assert_eq!(got.to_bits(), bits, "{average} {negative}");
+        }
+    }
+
     fn reduction_pct(w: &DahlWindow, load: f64, v: f64, f0: f64) -> f64 {
         let out = w
             .average(
