@@ -62,12 +62,11 @@ pub const fn pair_code(first: u16, second: u16) -> Option<u16> {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct AdcRunning;
 
-/// Writes the plan: CFGR (DMA circular, 12 bits right-aligned, TIM1_TRGO2 rising edge, single
-/// scan per trigger, overrun overwrites), CFGR2 (no oversampling), SMPR1/SMPR2, SQR1.
-pub fn program_regular(adc: Adc, hook: &mut impl FnMut(Step)) -> Result<(), AdcRunning> {
-    if adc.cr().read().adstart() {
-        return Err(AdcRunning);
-    }
+/// CFGR of a converter on the PWM's trigger, the same for ADC1's scan and ADC2's current
+/// conversion: DMA circular, 12 bits right-aligned, TIM1_TRGO2 rising edge, one sequence per
+/// trigger (no continuous or discontinuous mode), overrun overwrites, injected queue disabled
+/// (its reset value; injected conversions are unused).
+pub fn triggered_cfgr() -> Cfgr {
     let mut cfgr = Cfgr(0);
     cfgr.set_dmaen(Dmaen::ENABLE);
     cfgr.set_dmacfg(Dmacfg::CIRCULAR);
@@ -78,8 +77,16 @@ pub fn program_regular(adc: Adc, hook: &mut impl FnMut(Step)) -> Result<(), AdcR
     cfgr.set_ovrmod(Ovrmod::OVERWRITE);
     cfgr.set_cont(false);
     cfgr.set_discen(false);
-    // Reset value of JQDIS (injected queue disabled); injected conversions are unused.
     cfgr.set_jqdis(true);
+    cfgr
+}
+
+/// Writes the plan: CFGR ([`triggered_cfgr`]), CFGR2 (no oversampling), SMPR1/SMPR2, SQR1.
+pub fn program_regular(adc: Adc, hook: &mut impl FnMut(Step)) -> Result<(), AdcRunning> {
+    if adc.cr().read().adstart() {
+        return Err(AdcRunning);
+    }
+    let cfgr = triggered_cfgr();
     adc.cfgr().write_value(cfgr);
     hook("ADC1_CFGR");
     adc.cfgr2().write_value(Cfgr2(0));

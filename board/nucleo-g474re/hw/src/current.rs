@@ -37,10 +37,10 @@
 //! Register layouts: RM0440 rev 8 (ADC, DMA, DMAMUX, advanced-control timer chapters).
 
 use crate::Step;
-use crate::adc::EXTSEL_TIM1_TRGO2;
+use crate::adc::{AdcRunning, triggered_cfgr};
 use crate::pac::adc::Adc;
-use crate::pac::adc::regs::{Cfgr, Cfgr2, Smpr, Sqr1};
-use crate::pac::adc::vals::{Dmacfg, Dmaen, Exten, Ovrmod, Res, SampleTime};
+use crate::pac::adc::regs::{Cfgr2, Smpr, Sqr1};
+use crate::pac::adc::vals::SampleTime;
 use crate::pac::bdma::Dma;
 use crate::pac::bdma::regs::Cr;
 use crate::pac::bdma::vals::{Dir, Pl, Size};
@@ -186,30 +186,14 @@ pub const fn aligned_start(write: usize) -> usize {
     write % RING_LEN / TABLE_LEN * TABLE_LEN
 }
 
-/// Refused: a regular conversion of ADC2 is running (its CFGR, SMPR and SQR are written only
-/// with ADSTART = 0).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct AdcRunning;
-
-/// Writes ADC2's plan: CFGR (DMA circular, 12 bits right-aligned, TIM1_TRGO2 rising edge, one
-/// conversion per trigger, overrun overwrites), CFGR2 (no oversampling), SMPR1 (IN2 at 2.5
-/// cycles), SQR1 (IN2 alone).
+/// Writes ADC2's plan: CFGR (the same trigger set-up as ADC1's, [`triggered_cfgr`]), CFGR2 (no
+/// oversampling), SMPR1 (IN2 at 2.5 cycles), SQR1 (IN2 alone). Refused ([`AdcRunning`]) while a
+/// regular conversion of ADC2 runs.
 pub fn program_adc(adc: Adc, hook: &mut impl FnMut(Step)) -> Result<(), AdcRunning> {
     if adc.cr().read().adstart() {
         return Err(AdcRunning);
     }
-    let mut cfgr = Cfgr(0);
-    cfgr.set_dmaen(Dmaen::ENABLE);
-    cfgr.set_dmacfg(Dmacfg::CIRCULAR);
-    cfgr.set_res(Res::BITS12);
-    cfgr.set_align(false);
-    cfgr.set_extsel(EXTSEL_TIM1_TRGO2);
-    cfgr.set_exten(Exten::RISING_EDGE);
-    cfgr.set_ovrmod(Ovrmod::OVERWRITE);
-    cfgr.set_cont(false);
-    cfgr.set_discen(false);
-    cfgr.set_jqdis(true);
+    let cfgr = triggered_cfgr();
     adc.cfgr().write_value(cfgr);
     hook("ADC2_CFGR");
     adc.cfgr2().write_value(Cfgr2(0));
