@@ -294,6 +294,7 @@ impl Station {
                 } else {
                     Q1_31::ZERO
                 };
+                self.controller.drive_replaced(output.amplitude);
             } else if self.start_pending {
                 self.start_pending = false;
                 // Locked: the friction loop starts at the found frequency, with the current

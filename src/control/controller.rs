@@ -58,6 +58,49 @@ pub(super) fn coulomb_load(load: Q16_16, factor: i64) -> Result<Q16_16, ModelErr
         .map_err(|_| too_large)
 }
 
+/// Largest reduction of the friction, as the model predicts it at the envelope of a drive
+/// the controller did not command (the resonance search), at which mu0 is still learned:
+/// 2^-10 of natural (0.1 %), a tenth of the reference scene's RMS error limit. A learned
+/// mu0 that much low is a steady error of the same size that no feedback sees.
+const NATURAL_MAX_REDUCTION: Q2_30 = Q2_30::from_bits(1 << 20);
+
+/// Whether the friction at `envelope` is natural by the model (within
+/// [`NATURAL_MAX_REDUCTION`]) at the present estimate. A model error counts as not natural.
+fn natural_at<M: FrictionModel + ?Sized>(
+    model: &M,
+    c: &Config,
+    s: &mut ControllerState,
+    envelope: Q1_31,
+) -> bool {
+    operating_point(model, c, s)
+        .and_then(|point| model.ratio(&point, envelope))
+        .is_ok_and(|ratio| ratio >= Q2_30::ONE.saturating_sub(NATURAL_MAX_REDUCTION).value)
+}
+
+/// The model's operating point at the present estimate: the filtered load (at least the
+/// no-load guard; as the Coulomb force's load for a model whose load enters as `mu W`) and
+/// the filtered speed's magnitude.
+fn operating_point<M: FrictionModel + ?Sized>(
+    model: &M,
+    c: &Config,
+    s: &mut ControllerState,
+) -> Result<OperatingPoint, ModelError> {
+    let load = s.estimate.normal_force.max(c.estimator.min_normal_force);
+    let normal_force = if model.load_enters_as_coulomb_force() {
+        let (mu0, mu) = (s.natural.coefficient(), c.natural.prior);
+        if (s.coulomb.0, s.coulomb.1) != (mu0, mu) {
+            s.coulomb = (mu0, mu, coulomb_factor(mu0, mu));
+        }
+        coulomb_load(load, s.coulomb.2)?
+    } else {
+        load
+    };
+    Ok(OperatingPoint {
+        normal_force,
+        sliding_velocity: s.estimate.sliding_velocity.saturating_abs().value,
+    })
+}
+
 /// The controller's state (separate from its [`Config`]; never re-allocated).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ControllerState {
@@ -81,6 +124,11 @@ pub struct ControllerState {
     target: Option<(Target, PreparedTarget)>,
     /// The `mu0` and `mu` of the last [`coulomb_factor`], and the factor (Q33.30).
     coulomb: (Q2_30, Q2_30, i64),
+    /// The envelope estimate holds a drive this controller did not command
+    /// ([`Controller::drive_replaced`]), and whether the model said that drive reduced the
+    /// friction at some step; both cleared once the envelope has decayed to
+    /// `natural_max_drive`.
+    external_drive: (bool, bool),
 }
 
 /// The friction controller: configuration plus state.
@@ -128,6 +176,7 @@ impl Controller {
                 feedforward: Q1_31::ZERO,
                 target: None,
                 coulomb: (Q2_30::ZERO, Q2_30::ZERO, 1 << 30),
+                external_drive: (false, false),
             },
             config,
         }
@@ -140,7 +189,7 @@ impl Controller {
         let before = self.state.supervisor.state();
         match inputs.sensor_fault.or_else(|| self.implausible(inputs)) {
             Some(fault) => self.state.supervisor.latch(fault.into()),
-            None => self.estimate(inputs),
+            None => self.estimate(inputs, model),
         }
         self.on_transition(before);
         let mut report = LoopReport::default();
@@ -193,7 +242,7 @@ impl Controller {
         }
     }
 
-    fn estimate(&mut self, inputs: &Inputs) {
+    fn estimate<M: FrictionModel + ?Sized>(&mut self, inputs: &Inputs, model: &M) {
         let (c, s) = (&self.config, &mut self.state);
         s.estimate = s.estimator.update(
             &c.estimator,
@@ -210,7 +259,18 @@ impl Controller {
             (true, true) => Contact::Ok,
         };
         // mu0 is the friction without vibration: learn it only while sliding, drive off.
-        let drive_off = s.shaper.envelope() <= c.natural_max_drive;
+        let envelope = s.shaper.envelope();
+        let mut drive_off = envelope <= c.natural_max_drive;
+        if drive_off {
+            s.external_drive = (false, false);
+        } else if s.external_drive == (true, false) && s.contact == Contact::Ok {
+            // The resonance search's own low drive: it leaves the friction natural where the
+            // model says so (the Littmann law's dead zone v_a <= v), and mu0 is learned on.
+            // Once it did not, the filtered readings lag the envelope's decay: learning
+            // waits for the envelope to die out, as after the controller's own drive.
+            drive_off = natural_at(model, c, s, envelope);
+            s.external_drive.1 = !drive_off;
+        }
         if s.contact == Contact::Ok && drive_off && s.supervisor.state() != SupervisorState::Fault {
             s.natural.learn(&c.natural, s.estimate.coefficient);
         }
@@ -265,20 +325,7 @@ impl Controller {
             report.saturation.integral_frozen = true;
             Q1_31::ZERO
         } else {
-            let load = estimate.normal_force.max(c.estimator.min_normal_force);
-            let normal_force = if model.load_enters_as_coulomb_force() {
-                let (mu0, mu) = (s.natural.coefficient(), c.natural.prior);
-                if (s.coulomb.0, s.coulomb.1) != (mu0, mu) {
-                    s.coulomb = (mu0, mu, coulomb_factor(mu0, mu));
-                }
-                coulomb_load(load, s.coulomb.2)?
-            } else {
-                load
-            };
-            let point = OperatingPoint {
-                normal_force,
-                sliding_velocity: estimate.sliding_velocity.saturating_abs().value,
-            };
+            let point = operating_point(model, c, s)?;
             // The reference: what the model says the cells should read now, given the drive
             // actually applied (envelope estimate) and the same filter as the measurement.
             // Without vibration F'/F is 1 by definition: no model call while the drive is off.
@@ -379,6 +426,15 @@ impl Controller {
             .start(s.target.is_some(), s.contact, s.shaper.command())?;
         self.on_transition(before);
         Ok(())
+    }
+
+    /// The drive applied over the last step was `amplitude`, not this controller's command:
+    /// another owner drove the transducer (the resonance search of `freq auto`). The envelope
+    /// estimate follows what was applied, so that the prediction, the lead and the test for
+    /// learning mu0 with the drive off see the vibration the search left behind.
+    pub fn drive_replaced(&mut self, amplitude: Q1_31) {
+        self.state.shaper.replace(&self.config.shaper, amplitude);
+        self.state.external_drive.0 = true;
     }
 
     /// `stop`: disarms and ramps the drive down. Always accepted.

@@ -594,3 +594,69 @@ fn bad_sensor_lag_and_learning_times_are_named() {
         .is_ok()
     );
 }
+
+/// Steps with the drive replaced by `applied` (as the station does while the resonance
+/// search drives): the plant gets `applied`, the controller is told so. Returns mu0.
+fn run_replaced(
+    ctl: &mut Controller,
+    model: &LittmannModel,
+    plant: &mut Plant,
+    applied: f64,
+    steps: usize,
+) -> f64 {
+    let applied = Q1_31::from_f64(applied).unwrap();
+    for _ in 0..steps {
+        let out = ctl.step(&plant.measure(), model);
+        assert_eq!(
+            out.amplitude,
+            Q1_31::ZERO,
+            "idle: the controller commands nothing"
+        );
+        ctl.drive_replaced(applied);
+        plant.advance(applied);
+    }
+    ctl.natural_coefficient().to_f64()
+}
+
+#[test]
+fn a_drive_the_controller_did_not_command_stops_mu0_learning_where_it_changes_friction() {
+    let (mut ctl, model, mut plant) = setup();
+    ctl.set_target(HALF).unwrap();
+    run(&mut ctl, &model, &mut plant, 60);
+    let learned = ctl.natural_coefficient().to_f64();
+    assert!((learned - 0.3).abs() < 1e-3, "mu0 {learned}");
+    // The search's drive in the Littmann dead zone (0.3 x 0.0754 m/s < 0.038 m/s): friction
+    // stays natural by the model, so mu0 is learned on; the plant's mu moves and mu0 follows.
+    plant.mu = 0.33;
+    let followed = run_replaced(&mut ctl, &model, &mut plant, 0.3, 100);
+    assert!(plant.ratio() == 1.0 && followed > 0.31, "mu0 {followed}");
+    // A drive above the dead zone lowers the friction: mu0 must not learn it. (It learns on
+    // while the envelope estimate rises through the model's dead zone, which the model
+    // leaves earlier than this plant: 0.0754 against 0.068 m/s at full drive.)
+    let mut held = followed;
+    while plant.ratio() == 1.0 {
+        held = run_replaced(&mut ctl, &model, &mut plant, 0.9, 1);
+    }
+    let after = run_replaced(&mut ctl, &model, &mut plant, 0.9, 100);
+    assert!(plant.ratio() < 0.8, "the plant's friction is reduced");
+    assert_eq!(
+        after, held,
+        "mu0 held while the replaced drive reduces friction"
+    );
+    // Without being told, the controller would have taken the reduced friction for mu0.
+    let (mut blind, _, mut blind_plant) = setup();
+    blind.set_target(HALF).unwrap();
+    run(&mut blind, &model, &mut blind_plant, 60);
+    for _ in 0..100 {
+        blind.step(&blind_plant.measure(), &model);
+        blind_plant.advance(Q1_31::from_f64(0.9).unwrap());
+    }
+    assert!(blind.natural_coefficient().to_f64() < 0.28);
+    // The drive off again: the filtered readings lag the envelope, so mu0 waits until the
+    // envelope estimate has died out (to 1e-3: about 7 tau, 54 steps), then learns again.
+    let decaying = run_replaced(&mut ctl, &model, &mut plant, 0.0, 50);
+    assert_eq!(decaying, held, "still vibrating, or the readings still lag");
+    run(&mut ctl, &model, &mut plant, 200);
+    let relearned = ctl.natural_coefficient().to_f64();
+    assert!(relearned > held + 0.002, "mu0 {relearned}, held {held}");
+}

@@ -100,6 +100,8 @@ pub struct Shaped {
 pub struct DriveShaper {
     command: Q1_31,
     envelope: LowPass<31>,
+    /// The envelope estimate before the last command was applied ([`Self::replace`]).
+    before: LowPass<31>,
 }
 
 impl DriveShaper {
@@ -108,6 +110,7 @@ impl DriveShaper {
         Self {
             command: Q1_31::ZERO,
             envelope: LowPass::new(Q1_31::ZERO),
+            before: LowPass::new(Q1_31::ZERO),
         }
     }
 
@@ -137,7 +140,16 @@ impl DriveShaper {
     /// advances the envelope estimate with it. Negative values are taken as zero.
     pub fn apply(&mut self, config: &ShaperConfig, amplitude: Q1_31) {
         self.command = amplitude.max(Q1_31::ZERO);
+        self.before = self.envelope;
         self.envelope.update(&config.envelope, self.command);
+    }
+
+    /// Replaces the last command by `amplitude`, the drive actually applied over that step
+    /// (another owner drove the transducer: the resonance search), and advances the envelope
+    /// estimate from where it was before that step with it. Negative values are taken as zero.
+    pub fn replace(&mut self, config: &ShaperConfig, amplitude: Q1_31) {
+        self.envelope = self.before;
+        self.apply(config, amplitude);
     }
 
     /// The last command, Q1.31 fraction of full scale in [0, 1).
@@ -187,6 +199,21 @@ mod tests {
             );
             assert!((shaper.envelope().to_f64() - true_envelope).abs() < 1e-8);
         }
+    }
+
+    #[test]
+    fn a_replaced_command_advances_the_envelope_from_before_it() {
+        let config = ShaperConfig::new(0.8e-3, 0.25e-3, 0.5e-3, 1e-4).unwrap();
+        let mut told = DriveShaper::new();
+        let mut applied = DriveShaper::new();
+        for k in 0..30 {
+            let search = a(if k < 20 { 0.1 } else { 0.0 });
+            told.drive(&config, a(0.6), a(0.9));
+            told.replace(&config, search);
+            applied.apply(&config, search);
+            assert_eq!(told, applied, "step {k}");
+        }
+        assert!(told.envelope().to_f64() > 0.02 && told.command() == Q1_31::ZERO);
     }
 
     #[test]

@@ -9,7 +9,12 @@
 //! sonolube scene --all [--out DIR]
 //! sonolube scene NAME|--all --seeds N|A-B [--plot PATH.svg]
 //! sonolube scene NAME --mismatch|--envelope|--noise [--seeds N|A-B] [--out DIR]
+//! sonolube scene NAME --mismatch --pinned [--seeds N|A-B]
 //! ```
+//!
+//! The mismatch grid runs `freq auto` before `start` (the search, then the tracker, on the
+//! transducer's complex envelope): a resonance known only to +-0.5 % must be followed.
+//! `--pinned` holds the drive at the scene's frequency instead.
 //!
 //! `--seeds`, `--mismatch`, `--envelope` and `--noise` are the robustness sweeps ([`robust`]):
 //! many runs over every core, a table per criterion (pass rate, percentiles, worst run), a
@@ -72,7 +77,8 @@ pub use report::{model_line, model_name, short};
 const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml] [--model VARIANT]\n       \
                      sonolube scene --all [--out DIR]\n       \
                      sonolube scene NAME|--all --seeds N|A-B [--plot PATH.svg]\n       \
-                     sonolube scene NAME --mismatch|--envelope|--noise [--seeds N|A-B] [--out DIR]\n\
+                     sonolube scene NAME --mismatch|--envelope|--noise [--seeds N|A-B] [--out DIR]\n       \
+                     sonolube scene NAME --mismatch --pinned [--seeds N|A-B]\n\
                      exit status: 0 every criterion passes (every run of a sweep); 1 one fails, \
                      or the scene cannot run (a file that cannot be read or is invalid, values \
                      that cannot build a run); 2 a usage error\n";
@@ -87,6 +93,7 @@ pub fn run(args: &[String]) -> ExitCode {
     let mut seeds = None;
     let mut plot = None;
     let mut sweep = None;
+    let mut pinned = false;
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
         match arg.as_str() {
@@ -96,7 +103,7 @@ pub fn run(args: &[String]) -> ExitCode {
                     return usage("one of --mismatch, --envelope, --noise at a time");
                 }
                 sweep = Some(match arg.as_str() {
-                    "--mismatch" => robust::Sweep::Mismatch,
+                    "--mismatch" => robust::Sweep::Mismatch(robust::GridDrive::FreqAuto),
                     "--envelope" => robust::Sweep::Envelope,
                     _ => robust::Sweep::Noise,
                 });
@@ -119,6 +126,7 @@ pub fn run(args: &[String]) -> ExitCode {
                     },
                 }
             }
+            "--pinned" => pinned = true,
             "-h" | "--help" => {
                 print!("{USAGE}");
                 return ExitCode::SUCCESS;
@@ -126,6 +134,14 @@ pub fn run(args: &[String]) -> ExitCode {
             flag if flag.starts_with('-') => return usage(&format!("unknown option {flag}")),
             _ if name.is_none() => name = Some(arg.clone()),
             _ => return usage(&format!("unexpected argument {arg}")),
+        }
+    }
+    if pinned {
+        match sweep {
+            Some(robust::Sweep::Mismatch(_)) => {
+                sweep = Some(robust::Sweep::Mismatch(robust::GridDrive::Pinned));
+            }
+            _ => return usage("--pinned goes with --mismatch"),
         }
     }
     let robust = seeds.is_some() || sweep.is_some();

@@ -19,6 +19,28 @@ pub const GAIN_LEVELS: [f64; 3] = [-0.02, 0.0, 0.02];
 /// Transducer resonance over the drive frequency, minus one (+-0.5 % of f0).
 pub const DETUNE_LEVELS: [f64; 3] = [-0.005, 0.0, 0.005];
 
+/// How the grid's runs drive the transducer whose resonance is off the scene's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GridDrive {
+    /// `freq auto` before `start`, as an operator who does not know f0 to 0.5 % runs it: the
+    /// search, then the tracker, on the transducer's complex (Butterworth-Van Dyke) envelope,
+    /// which samples its current for them. The default.
+    FreqAuto,
+    /// The drive held at the scene's frequency (`--pinned`): the real envelope with the
+    /// settled gain `1 / sqrt(1 + x^2)` at the detuning `x`.
+    Pinned,
+}
+
+impl GridDrive {
+    /// The words of the sweep's header.
+    pub const fn text(self) -> &'static str {
+        match self {
+            GridDrive::FreqAuto => "drive freq auto (search, then track)",
+            GridDrive::Pinned => "drive pinned at the scene's frequency",
+        }
+    }
+}
+
 /// One point of the mismatch grid.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Mismatch {
@@ -65,10 +87,11 @@ impl Mismatch {
     }
 
     /// `scene` with this mismatch: the plant's mu (and mu_s) and k_t set to the controller's
-    /// times the levels, the resonance moved by `detune` f0 with the drive frequency kept, and
-    /// cells whose offset and gain error were calibrated away except the gain error `gain` (so
-    /// the run uses the datasheet calibration on cells with exactly that error).
-    pub fn apply<'a>(&self, scene: &Scene<'a>) -> (Scene<'a>, CellCalibration) {
+    /// times the levels, the resonance moved by `detune` f0 (the scene's drive frequency
+    /// kept as the nominal one), driven as `drive` says, and cells whose offset and gain
+    /// error were calibrated away except the gain error `gain` (so the run uses the datasheet
+    /// calibration on cells with exactly that error).
+    pub fn apply<'a>(&self, scene: &Scene<'a>, drive: GridDrive) -> (Scene<'a>, CellCalibration) {
         let mut s = *scene;
         let mu_scale = self.mu * scene.controller.mu / scene.plant.mu;
         s.plant.mu = scene.plant.mu * mu_scale;
@@ -80,6 +103,10 @@ impl Mismatch {
             s.mismatch.k_t_ratio = Some(self.k_t);
         }
         s.transducer.resonance_hz = scene.transducer.drive_hz * (1.0 + self.detune);
+        if drive == GridDrive::FreqAuto {
+            s.transducer.shift.bvd_envelope = true;
+            s.transducer.shift.freq_auto = true;
+        }
         let exact = |cell: &LoadCell, gain: f64| LoadCell {
             offset_n: 0.0,
             gain_error: gain,
@@ -91,11 +118,12 @@ impl Mismatch {
     }
 }
 
-/// The runs of the mismatch grid on `scene`, each on every seed of `seeds`.
-pub fn mismatch_runs<'a>(scene: &Scene<'a>, seeds: &[u64]) -> Vec<Run<'a>> {
+/// The runs of the mismatch grid on `scene` driven as `drive` says, each on every seed of
+/// `seeds`.
+pub fn mismatch_runs<'a>(scene: &Scene<'a>, seeds: &[u64], drive: GridDrive) -> Vec<Run<'a>> {
     let mut runs = Vec::new();
     for point in Mismatch::grid() {
-        let (changed, calibration) = point.apply(scene);
+        let (changed, calibration) = point.apply(scene, drive);
         for &seed in seeds {
             runs.push(Run {
                 label: if seeds.len() > 1 {
@@ -313,7 +341,11 @@ mod tests {
             detune: -0.005,
         };
         assert!(grid.contains(&corner));
-        let (s, calibration) = corner.apply(scene);
+        let (s, calibration) = corner.apply(scene, GridDrive::Pinned);
+        assert!(!s.transducer.shift.freq_auto && !s.transducer.shift.bvd_envelope);
+        let (tracked, _) = corner.apply(scene, GridDrive::FreqAuto);
+        assert!(tracked.transducer.shift.freq_auto && tracked.transducer.shift.bvd_envelope);
+        assert_eq!(tracked.plant, s.plant);
         assert!((s.plant.mu - 0.26).abs() < 1e-12);
         assert_eq!(s.plant.k_t_n_per_m, Some(1.25e7));
         assert_eq!(s.controller, scene.controller);

@@ -20,6 +20,7 @@ use std::process::ExitCode;
 use sonolube::scene::{SCENES, Scene};
 use sonolube_sim::RunSummary;
 
+pub use super::grid::GridDrive;
 use super::grid::{
     ENVELOPE_LOADS_N, ENVELOPE_SPEEDS, NOISE_LEVELS_PCT, envelope_points, load_text, mismatch_runs,
     with_noise,
@@ -35,8 +36,8 @@ use crate::scene_file::scenes_dir;
 pub enum Sweep {
     /// Noise seeds only.
     Seeds,
-    /// The mismatch grid ([`super::grid::Mismatch::grid`]).
-    Mismatch,
+    /// The mismatch grid ([`super::grid::Mismatch::grid`]), the transducer driven as said.
+    Mismatch(GridDrive),
     /// The operating envelope ([`super::grid::envelope_points`]).
     Envelope,
     /// Sensor noise levels ([`NOISE_LEVELS_PCT`]).
@@ -90,12 +91,13 @@ pub fn run(
                 println!("{}: {} runs, {}", scene.name, runs.len(), seeds_text(seeds));
                 sweep_runs(scene, &runs, jobs)
             }
-            Sweep::Mismatch => {
-                let runs = mismatch_runs(scene, seeds);
+            Sweep::Mismatch(drive) => {
+                let runs = mismatch_runs(scene, seeds, drive);
                 println!(
                     "{}: mismatch grid (plant mu x0.7/1/1.3, k_t x0.5/1/2, cell gain -2/0/+2 %, \
-                     resonance -0.5/0/+0.5 % of f0), {} runs, {}",
+                     resonance -0.5/0/+0.5 % of f0), {}, {} runs, {}",
                     scene.name,
+                    drive.text(),
                     runs.len(),
                     seeds_text(seeds)
                 );
