@@ -79,7 +79,10 @@
 //! 0.72 and -0.42, a 0.3 ms time constant, the scale of the response the mismatch is seen
 //! through (0.25 ms; the force filters' lag is in the prediction too); faster overcorrects,
 //! because the mismatch seen mid-transient belongs to another amplitude (with ±20 % mismatch
-//! `d` itself changes with `c` by a factor 0.8 to 1.25, the margin this leaves). **Slow gains `kp` 0.1, `ki` 300 /s**
+//! `d` itself changes with `c` by a factor 0.8 to 1.25, the margin this leaves). That is the
+//! baseline; the scenes and boards run **ki 6000 /s** ([`FAST_GAINS`], `kiT` 0.6: poles 0.6 and
+//! -0.5), which learns the stiffest corner of the mismatch grid's model error before the
+//! feedforward's overshoot passes 5 %. **Slow gains `kp` 0.1, `ki` 300 /s**
 //! ([`STEADY_GAINS`]): poles 0.973 and -0.103, 3.6 ms, fast enough to follow a model error that
 //! moves with the operating point. The gains start fast when the loop closes or
 //! the target changes and fade to the slow set with **`tau_boost` = 3 ms** (the settling budget):
@@ -155,6 +158,6 @@ pub use sliding::{SlidingConfig, SlidingDetector};
 pub use supervisor::{Contact, RampConfig, Supervisor};
 pub use target::{ForceQ, PreparedTarget};
 pub use tuning::{
-    FORCE_FILTER_HZ, NATURAL_LEARN_S, NATURAL_PRIOR_WEIGHT, SLIDING_DEBOUNCE_S, STEADY_GAINS,
-    VELOCITY_FILTER_HZ, controller_settings,
+    FAST_GAINS, FORCE_FILTER_HZ, NATURAL_LEARN_S, NATURAL_PRIOR_WEIGHT, SLIDING_DEBOUNCE_S,
+    STEADY_GAINS, VELOCITY_FILTER_HZ, controller_settings,
 };

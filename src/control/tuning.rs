@@ -77,17 +77,32 @@ pub const NATURAL_LEARN_S: f64 = 3e-3;
 /// reference scene's steady RMS error goes from 0.68 % to 0.69 %.
 pub const STEADY_GAINS: (f64, f64) = (0.1, 300.0);
 
+/// Fast PI gains (the set the boost starts from at a start or a target change):
+/// proportional (ratio per ratio) and integral (1/s).
+///
+/// The baseline's kp 0.3, ki 4000 /s (`kiT` 0.4, poles 0.72 and -0.42) left the mismatch
+/// grid's stiffest, highest-friction corner (plant mu x1.3 and k_t x2 of the controller's:
+/// the plant reduces the friction more at a given amplitude than the model says) to the
+/// feedforward's own overshoot for too long: 5.04-5.28 % of the step (limit 5 %) at 6 of 81
+/// points, with the drive pinned or following the resonance. The overshoot shrinks as the
+/// integral learns that model error sooner (ki 3000, 4000, 5000, 6000 /s: worst 5.6, 5.3,
+/// 5.0, 4.8 %); at ki 6000 /s (`kiT` 0.6: poles 0.6 and -0.5, a 0.2 ms time constant, still
+/// well inside the unit circle) every grid point passes on the scene's seed and the seed
+/// sweep of every scene is unchanged in its verdicts (1,300 of 1,300). The steady gains
+/// take over within the boost's 3 ms, so the steady RMS error does not see the faster set.
+pub const FAST_GAINS: (f64, f64) = (0.3, 6_000.0);
+
 /// The controller's settings for `scene`: [`Settings::REFERENCE`] with the tuning's
 /// departures ([`FORCE_FILTER_HZ`] for both force filters, [`VELOCITY_FILTER_HZ`],
-/// [`NATURAL_PRIOR_WEIGHT`], [`SLIDING_DEBOUNCE_S`], [`NATURAL_LEARN_S`], [`STEADY_GAINS`]) and
+/// [`NATURAL_PRIOR_WEIGHT`], [`SLIDING_DEBOUNCE_S`], [`NATURAL_LEARN_S`], [`STEADY_GAINS`],
+/// [`FAST_GAINS`]) and
 /// what the scene fixes: the control period, the actuator ratings at the drive frequency, the
 /// controller's natural coefficient as the prior of mu0, plausible ranges of the readings
 /// (1.1 x each cell's full scale, twice the fastest sliding speed but at least 5 m/s), the
 /// no-load guard (half the lightest load of the scene's contents, at most the baseline's
 /// 0.5 N: at 0.5 N the baseline's guard judged the loaded contact unloaded on many samples and
 /// the loop never ran), the transducer's envelope time constant and the tangential cell's lag.
-/// The fast gains, the
-/// boost, the lead, the slew and the ramps keep their reference values.
+/// The boost, the lead, the slew and the ramps keep their reference values.
 ///
 /// **The envelope is the transducer's; the cell's lag is a stage of its own.** The PI compares
 /// the measured friction with the model's prediction at the estimated envelope; the
@@ -119,6 +134,7 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
     let cell_lag_s = 1.0 / (core::f64::consts::TAU * scene.tangential_cell.bandwidth_hz);
     let envelope = scene.transducer.envelope_time_constant_s();
     let (kp, ki_per_s) = STEADY_GAINS;
+    let (kp_fast, ki_fast_per_s) = FAST_GAINS;
     Settings {
         period_s: scene.control_period_s(),
         normal_bandwidth_hz: FORCE_FILTER_HZ,
@@ -148,6 +164,8 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
         response_time_constant_s: libm::fmin(reference.response_time_constant_s, envelope),
         kp,
         ki_per_s,
+        kp_fast,
+        ki_fast_per_s,
         actuator: ActuatorRatings {
             max_voltage_v: scene.actuator.max_voltage_v,
             max_current_a: scene.actuator.max_current_a,
@@ -194,8 +212,9 @@ mod tests {
         assert_eq!(s.sliding_debounce_s, SLIDING_DEBOUNCE_S);
         assert_eq!(
             (s.kp_fast, s.ki_fast_per_s, s.boost_time_constant_s),
-            (0.3, 4_000.0, 3e-3)
+            (0.3, 6_000.0, 3e-3)
         );
+        assert_eq!((s.kp_fast, s.ki_fast_per_s), FAST_GAINS);
         assert!((s.tangential_force_range_n - 2.2).abs() < 1e-12);
         assert_eq!(s.velocity_range_m_s, 5.0);
         assert!(crate::control::Config::new(&s).is_ok());
