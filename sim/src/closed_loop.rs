@@ -129,11 +129,21 @@ impl<'a> ClosedLoop<'a> {
         scene: &Scene<'a>,
         selection: sonolube::variant::Selection,
     ) -> Result<Self, SimError> {
+        Self::with_selection_calibrated(scene, selection, COMMISSIONED)
+    }
+
+    /// [`ClosedLoop::with_selection`] with the cells' `calibration` given (the robustness
+    /// sweeps: a mismatch point's cells carry exactly their gain error).
+    pub fn with_selection_calibrated(
+        scene: &Scene<'a>,
+        selection: sonolube::variant::Selection,
+        calibration: CellCalibration,
+    ) -> Result<Self, SimError> {
         let settings = controller_settings(scene);
         let normal = super::sensor_channel(&scene.normal_cell)?;
         let tangential = super::sensor_channel(&scene.tangential_cell)?;
         let station = Station::with_selection(scene, &settings, selection, normal, tangential)?;
-        Self::scripted(scene, station, COMMISSIONED)
+        Self::scripted(scene, station, calibration)
     }
 
     /// The run of `scene` with the controller `settings` and the cells' `calibration` given.

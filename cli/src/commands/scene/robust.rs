@@ -302,7 +302,28 @@ fn envelope(scene: &Scene<'_>, seeds: &[u64], jobs: usize, out: &Path) -> Result
     for line in failures(&runs, &results) {
         println!("  FAIL {line}");
     }
+    // What limits the misses: the same runs with both cells' noise at zero.
+    let quiet: Vec<Run<'_>> = runs.iter().map(without_cell_noise).collect();
+    let quiet_results = run_all(&quiet, jobs, "envelope, cells without noise");
+    let quiet_passed = quiet_results.iter().filter(|r| is_pass(r)).count();
+    println!(
+        "  the same {} runs with both cells' noise at zero (noise_rms_pct_fs = 0): {quiet_passed}/{} pass",
+        quiet.len(),
+        quiet.len()
+    );
+    for line in failures(&quiet, &quiet_results) {
+        println!("  FAIL without noise: {line}");
+    }
     Ok(Done { stats, results })
+}
+
+/// `run` with both load cells' noise at zero, everything else kept.
+fn without_cell_noise<'a>(run: &Run<'a>) -> Run<'a> {
+    let mut quiet = run.clone();
+    quiet.scene.normal_cell.noise_rms_pct_fs = 0.0;
+    quiet.scene.tangential_cell.noise_rms_pct_fs = 0.0;
+    quiet.label = format!("{} (cells without noise)", run.label);
+    quiet
 }
 
 /// The built-in scenes.
@@ -313,6 +334,23 @@ pub fn builtin() -> Vec<Scene<'static>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_quiet_twin_of_a_run_changes_the_cells_noise_only() {
+        let scene = sonolube::scene::find("reference").expect("built in");
+        let run = Run::seeded(scene, 7);
+        let quiet = without_cell_noise(&run);
+        assert_eq!(quiet.scene.normal_cell.noise_rms_pct_fs, 0.0);
+        assert_eq!(quiet.scene.tangential_cell.noise_rms_pct_fs, 0.0);
+        assert!(scene.normal_cell.noise_rms_pct_fs > 0.0);
+        let restored = Scene {
+            normal_cell: scene.normal_cell,
+            tangential_cell: scene.tangential_cell,
+            ..quiet.scene
+        };
+        assert_eq!(restored, run.scene);
+        assert_eq!(quiet.calibration, run.calibration);
+    }
 
     #[test]
     fn seeds_parse_as_a_count_or_a_range_and_refuse_the_rest() {

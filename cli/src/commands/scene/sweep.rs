@@ -12,7 +12,6 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-use sonolube::control::controller_settings;
 use sonolube::scene::{Criterion, Scene};
 use sonolube_sim::{COMMISSIONED, CellCalibration, ClosedLoop, Measured, RunSummary};
 
@@ -44,10 +43,13 @@ impl<'a> Run<'a> {
     }
 }
 
-/// Runs `scene` to its end with its own controller settings and `calibration`; the summary,
-/// or why it cannot run.
+/// Runs `scene` to its end with its own controller settings, the model variant `sonolube
+/// scene` runs it with ([`crate::speed::table_rs::select_on_host`]: the firmware's choice for
+/// a built-in scene, one measured on the host for a scene file) and `calibration`; the
+/// summary, or why it cannot run.
 pub fn summary_of(scene: &Scene<'_>, calibration: CellCalibration) -> Result<RunSummary, String> {
-    let mut sim = ClosedLoop::with_settings(scene, &controller_settings(scene), calibration)
+    let selection = crate::speed::table_rs::select_on_host(scene)?;
+    let mut sim = ClosedLoop::with_selection_calibrated(scene, selection, calibration)
         .map_err(|e| format!("cannot build the run: {e:?}"))?;
     Ok(sim.run())
 }
