@@ -80,6 +80,7 @@ fn natural_at<M: FrictionModel + ?Sized>(
 /// The model's operating point at the present estimate: the filtered load (at least the
 /// no-load guard; as the Coulomb force's load for a model whose load enters as `mu W`) and
 /// the filtered speed's magnitude.
+#[inline(always)]
 fn operating_point<M: FrictionModel + ?Sized>(
     model: &M,
     c: &Config,
