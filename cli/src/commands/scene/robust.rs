@@ -314,7 +314,36 @@ fn envelope(scene: &Scene<'_>, seeds: &[u64], jobs: usize, out: &Path) -> Result
     for line in failures(&quiet, &quiet_results) {
         println!("  FAIL without noise: {line}");
     }
+    // The same runs with cells a user would size to the load (same noise in % FS).
+    let sized: Vec<Run<'_>> = runs.iter().map(with_cells_sized_to_the_load).collect();
+    let sized_results = run_all(&sized, jobs, "envelope, cells sized to the load");
+    let sized_passed = sized_results.iter().filter(|r| is_pass(r)).count();
+    println!(
+        "  the same {} runs with cells sized to the load (normal {CELL_MARGIN} x the load, \
+         tangential {CELL_MARGIN} x the plant's natural friction, noise still in % FS): \
+         {sized_passed}/{} pass",
+        sized.len(),
+        sized.len()
+    );
+    for line in failures(&sized, &sized_results) {
+        println!("  FAIL with sized cells: {line}");
+    }
     Ok(Done { stats, results })
+}
+
+/// Full scale of a cell sized to the load, over the largest force it reads.
+const CELL_MARGIN: f64 = 2.5;
+
+/// `run` with its cells sized to its largest normal load `W` (the contents' top): the normal
+/// cell's full scale [`CELL_MARGIN`] `W`, the tangential cell's [`CELL_MARGIN`] `mu W` with the
+/// plant's mu; their noise, in % of full scale, kept.
+fn with_cells_sized_to_the_load<'a>(run: &Run<'a>) -> Run<'a> {
+    let mut sized = run.clone();
+    let load = run.scene.contents.load_max_n;
+    sized.scene.normal_cell.full_scale_n = CELL_MARGIN * load;
+    sized.scene.tangential_cell.full_scale_n = CELL_MARGIN * run.scene.plant.mu * load;
+    sized.label = format!("{} (cells sized to the load)", run.label);
+    sized
 }
 
 /// `run` with both load cells' noise at zero, everything else kept.
@@ -350,6 +379,23 @@ mod tests {
         };
         assert_eq!(restored, run.scene);
         assert_eq!(quiet.calibration, run.calibration);
+    }
+
+    #[test]
+    fn sized_cells_follow_the_load_and_keep_their_noise() {
+        let scene = sonolube::scene::find("reference").expect("built in");
+        let run = Run::seeded(scene, 7);
+        let sized = with_cells_sized_to_the_load(&run);
+        let load = scene.contents.load_max_n;
+        assert!((sized.scene.normal_cell.full_scale_n - 2.5 * load).abs() < 1e-12);
+        let friction = scene.plant.mu * load;
+        assert!((sized.scene.tangential_cell.full_scale_n - 2.5 * friction).abs() < 1e-12);
+        assert_eq!(
+            sized.scene.normal_cell.noise_rms_pct_fs,
+            scene.normal_cell.noise_rms_pct_fs
+        );
+        assert_eq!(sized.scene.plant, scene.plant);
+        assert_eq!(sized.scene.contents, scene.contents);
     }
 
     #[test]
