@@ -102,6 +102,18 @@ fn operating_point<M: FrictionModel + ?Sized>(
     })
 }
 
+/// A drive in the envelope estimate that the controller did not command (the search's).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum ExternalDrive {
+    /// None (or it has died out).
+    None,
+    /// One, under which the model has said the friction stays natural so far: mu0 is learned.
+    Natural,
+    /// One under which the model said the friction is reduced: mu0 waits until it dies out
+    /// (the filtered readings lag the envelope).
+    Reduced,
+}
+
 /// The controller's state (separate from its [`Config`]; never re-allocated).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ControllerState {
@@ -125,11 +137,10 @@ pub struct ControllerState {
     target: Option<(Target, PreparedTarget)>,
     /// The `mu0` and `mu` of the last [`coulomb_factor`], and the factor (Q33.30).
     coulomb: (Q2_30, Q2_30, i64),
-    /// The envelope estimate holds a drive this controller did not command
-    /// ([`Controller::drive_replaced`]), and whether the model said that drive reduced the
-    /// friction at some step; both cleared once the envelope has decayed to
+    /// Whether the envelope estimate holds a drive this controller did not command
+    /// ([`Controller::drive_replaced`]); back to `None` once it has decayed to
     /// `natural_max_drive`.
-    external_drive: (bool, bool),
+    external_drive: ExternalDrive,
 }
 
 /// The friction controller: configuration plus state.
@@ -177,7 +188,7 @@ impl Controller {
                 feedforward: Q1_31::ZERO,
                 target: None,
                 coulomb: (Q2_30::ZERO, Q2_30::ZERO, 1 << 30),
-                external_drive: (false, false),
+                external_drive: ExternalDrive::None,
             },
             config,
         }
@@ -263,14 +274,16 @@ impl Controller {
         let envelope = s.shaper.envelope();
         let mut drive_off = envelope <= c.natural_max_drive;
         if drive_off {
-            s.external_drive = (false, false);
-        } else if s.external_drive == (true, false) && s.contact == Contact::Ok {
+            s.external_drive = ExternalDrive::None;
+        } else if s.external_drive == ExternalDrive::Natural && s.contact == Contact::Ok {
             // The resonance search's own low drive: it leaves the friction natural where the
             // model says so (the Littmann law's dead zone v_a <= v), and mu0 is learned on.
             // Once it did not, the filtered readings lag the envelope's decay: learning
             // waits for the envelope to die out, as after the controller's own drive.
             drive_off = natural_at(model, c, s, envelope);
-            s.external_drive.1 = !drive_off;
+            if !drive_off {
+                s.external_drive = ExternalDrive::Reduced;
+            }
         }
         if s.contact == Contact::Ok && drive_off && s.supervisor.state() != SupervisorState::Fault {
             s.natural.learn(&c.natural, s.estimate.coefficient);
@@ -435,7 +448,9 @@ impl Controller {
     /// learning mu0 with the drive off see the vibration the search left behind.
     pub fn drive_replaced(&mut self, amplitude: Q1_31) {
         self.state.shaper.replace(&self.config.shaper, amplitude);
-        self.state.external_drive.0 = true;
+        if self.state.external_drive == ExternalDrive::None {
+            self.state.external_drive = ExternalDrive::Natural;
+        }
     }
 
     /// `stop`: disarms and ramps the drive down. Always accepted.

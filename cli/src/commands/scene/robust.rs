@@ -302,33 +302,48 @@ fn envelope(scene: &Scene<'_>, seeds: &[u64], jobs: usize, out: &Path) -> Result
     for line in failures(&runs, &results) {
         println!("  FAIL {line}");
     }
-    // What limits the misses: the same runs with both cells' noise at zero.
-    let quiet: Vec<Run<'_>> = runs.iter().map(without_cell_noise).collect();
-    let quiet_results = run_all(&quiet, jobs, "envelope, cells without noise");
-    let quiet_passed = quiet_results.iter().filter(|r| is_pass(r)).count();
-    println!(
-        "  the same {} runs with both cells' noise at zero (noise_rms_pct_fs = 0): {quiet_passed}/{} pass",
-        quiet.len(),
-        quiet.len()
+    // What limits the misses: the same runs with both cells' noise at zero, and with cells a
+    // user would size to the load (same noise in % FS).
+    rerun(
+        &runs,
+        jobs,
+        without_cell_noise,
+        "without noise",
+        "with both cells' noise at zero (noise_rms_pct_fs = 0)",
     );
-    for line in failures(&quiet, &quiet_results) {
-        println!("  FAIL without noise: {line}");
-    }
-    // The same runs with cells a user would size to the load (same noise in % FS).
-    let sized: Vec<Run<'_>> = runs.iter().map(with_cells_sized_to_the_load).collect();
-    let sized_results = run_all(&sized, jobs, "envelope, cells sized to the load");
-    let sized_passed = sized_results.iter().filter(|r| is_pass(r)).count();
-    println!(
-        "  the same {} runs with cells sized to the load (normal {CELL_MARGIN} x the load, \
-         tangential {CELL_MARGIN} x the plant's natural friction, noise still in % FS): \
-         {sized_passed}/{} pass",
-        sized.len(),
-        sized.len()
+    rerun(
+        &runs,
+        jobs,
+        with_cells_sized_to_the_load,
+        "with sized cells",
+        &format!(
+            "with cells sized to the load (normal {CELL_MARGIN} x the load, tangential \
+             {CELL_MARGIN} x the plant's natural friction, noise still in % FS)"
+        ),
     );
-    for line in failures(&sized, &sized_results) {
-        println!("  FAIL with sized cells: {line}");
-    }
     Ok(Done { stats, results })
+}
+
+/// Runs `runs` again, each changed by `change`, and prints how many pass (`what` says how
+/// they were changed) and the failures (tagged `tag`).
+fn rerun<'a>(
+    runs: &[Run<'a>],
+    jobs: usize,
+    change: fn(&Run<'a>) -> Run<'a>,
+    tag: &str,
+    what: &str,
+) {
+    let changed: Vec<Run<'a>> = runs.iter().map(change).collect();
+    let results = run_all(&changed, jobs, &format!("envelope, {tag}"));
+    let passed = results.iter().filter(|r| is_pass(r)).count();
+    println!(
+        "  the same {} runs {what}: {passed}/{} pass",
+        changed.len(),
+        changed.len()
+    );
+    for line in failures(&changed, &results) {
+        println!("  FAIL {tag}: {line}");
+    }
 }
 
 /// Full scale of a cell sized to the load, over the largest force it reads.
