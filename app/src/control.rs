@@ -7,7 +7,8 @@
 //! is counted in [`link::OVERRUNS`] (reported by `status` and in every telemetry record) and
 //! the ticker is re-aligned to now, so missed ticks are skipped rather than run in a burst.
 //! [`OVERRUN_FAULT_RUN`] overruns in a row latch the controller's `overrun` fault: the drive
-//! goes to zero until `clear`.
+//! goes to zero until `clear`. The run is counted afresh after each trip ([`OverrunRun`]), so
+//! a loop that still overruns after `clear` trips again [`OVERRUN_FAULT_RUN`] steps later.
 
 use embassy_time::{Duration, Instant, Ticker};
 use sonolube::protocol::{Command, ProtocolError};
@@ -17,6 +18,41 @@ use crate::snapshot::Snapshot;
 
 /// Overruns in a row that latch the `overrun` fault.
 pub const OVERRUN_FAULT_RUN: u32 = 3;
+
+/// Overruns in a row, and when they latch the fault.
+///
+/// The count restarts at zero after a step on time and after each trip: `clear` acknowledges
+/// the fault, and a loop that keeps overrunning after it must latch it again, not run on
+/// with the fault cleared (a count that only grows would pass the trip value once and never
+/// equal it again).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct OverrunRun {
+    in_a_row: u32,
+}
+
+impl OverrunRun {
+    /// Counts a step that overran; `true` when this one completes a run of
+    /// [`OVERRUN_FAULT_RUN`] (the caller latches the fault), which starts the count afresh.
+    pub fn overran(&mut self) -> bool {
+        self.in_a_row += 1;
+        if self.in_a_row >= OVERRUN_FAULT_RUN {
+            self.in_a_row = 0;
+            true
+        } else {
+            false
+        }
+    }
+
+    /// Counts a step that ended before its deadline: the run is broken.
+    pub fn on_time(&mut self) {
+        self.in_a_row = 0;
+    }
+
+    /// Overruns in the current run.
+    pub fn in_a_row(&self) -> u32 {
+        self.in_a_row
+    }
+}
 
 /// A board's control loop: its sensing, the station (cells, controller, model) and its drive.
 pub trait ControlLoop {
@@ -64,7 +100,7 @@ pub async fn run<L: ControlLoop>(control: &mut L) -> LoopStats {
     let mut period = Duration::from_hz(u64::from(rate_hz));
     let mut ticker = Ticker::every(period);
     let mut tick_at = Instant::now() + period;
-    let mut in_a_row = 0u32;
+    let mut run_of_overruns = OverrunRun::default();
     let mut seq = 0u32;
     let mut since_record = 0u32;
     loop {
@@ -113,15 +149,17 @@ pub async fn run<L: ControlLoop>(control: &mut L) -> LoopStats {
                     snapshot.control_cycles
                 );
             }
-            in_a_row += 1;
-            if in_a_row == OVERRUN_FAULT_RUN {
-                defmt::error!("{=u32} control overruns in a row: overrun fault", in_a_row);
+            if run_of_overruns.overran() {
+                defmt::error!(
+                    "{=u32} control overruns in a row: overrun fault",
+                    OVERRUN_FAULT_RUN
+                );
                 control.trip_overrun();
             }
             ticker.reset();
             tick_at = Instant::now() + period;
         } else {
-            in_a_row = 0;
+            run_of_overruns.on_time();
             tick_at = deadline;
         }
 
@@ -143,5 +181,37 @@ pub async fn run<L: ControlLoop>(control: &mut L) -> LoopStats {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Steps of a loop that overruns every period: which of them latch the fault.
+    fn trips_of_steady_overruns(steps: u32) -> Vec<u32> {
+        let mut run = OverrunRun::default();
+        (1..=steps).filter(|_| run.overran()).collect()
+    }
+
+    #[test]
+    fn a_steady_overrun_trips_every_run_of_three_so_again_after_clear() {
+        // Every step overruns: the fault latches at step 3; `clear` between steps 3 and 4
+        // (the loop runs on, still overrunning) must see it latch again at step 6, and so on.
+        assert_eq!(OVERRUN_FAULT_RUN, 3);
+        assert_eq!(trips_of_steady_overruns(10), vec![3, 6, 9]);
+    }
+
+    #[test]
+    fn a_step_on_time_breaks_the_run() {
+        let mut run = OverrunRun::default();
+        assert!(!run.overran());
+        assert!(!run.overran());
+        run.on_time();
+        assert_eq!(run.in_a_row(), 0);
+        assert!(!run.overran());
+        assert!(!run.overran());
+        assert!(run.overran());
+        assert_eq!(run.in_a_row(), 0);
     }
 }

@@ -13,7 +13,7 @@
 //!   UART, one reply per line, and the telemetry lines in between;
 //! - **supervisor** ([`heartbeat`] at boot, then [`supervisor::keeper`]): the boot self-check,
 //!   then the watchdog, fed only while the control loop advances.
-#![no_std]
+#![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 
 pub mod console;
