@@ -307,6 +307,39 @@ mod tests {
         );
     }
 
+    /// A `stop` while the run waits, armed, for the contact (in idle, or in the ramp-down
+    /// after a contact loss) disarms it: when the contact comes back the drive stays off
+    /// instead of restarting by itself.
+    #[test]
+    fn a_stop_while_armed_in_idle_or_ramp_down_disarms() {
+        let mut idle = Supervisor::new();
+        idle.start(true, Contact::NotSliding, Q1_31::ZERO).unwrap();
+        assert_eq!((idle.state(), idle.armed()), (SupervisorState::Idle, true));
+        idle.stop();
+        assert!(!idle.armed());
+        idle.follow_contact(Contact::Ok, Q1_31::ZERO);
+        assert_eq!(idle.state(), SupervisorState::Idle, "no restart from idle");
+
+        let mut ramp_down = Supervisor::new();
+        ramp_down.start(true, Contact::Ok, Q1_31::ZERO).unwrap();
+        ramp_down.follow_contact(Contact::NotSliding, Q1_31::ZERO);
+        assert_eq!(
+            (ramp_down.state(), ramp_down.armed()),
+            (SupervisorState::RampDown, true)
+        );
+        ramp_down.stop();
+        assert!(!ramp_down.armed());
+        ramp_down.follow_contact(Contact::Ok, Q1_31::from_f64_const(0.2));
+        assert_eq!(
+            ramp_down.state(),
+            SupervisorState::RampDown,
+            "no restart from the ramp-down"
+        );
+        ramp_down.finish_ramp_down();
+        ramp_down.follow_contact(Contact::Ok, Q1_31::ZERO);
+        assert_eq!(ramp_down.state(), SupervisorState::Idle);
+    }
+
     #[test]
     fn faults_latch_until_cleared() {
         let mut s = Supervisor::new();

@@ -289,3 +289,44 @@ fn settings_are_checked_and_reconfiguring_clamps() {
     assert!(tracker.tuning().frequency.millihertz().abs_diff(41_000_000) < 300);
     assert_eq!(config(&base).stack(), stack);
 }
+
+/// A window at zero amplitude (the drive paused) ends the loop's history: the next window's
+/// proportional term must not difference against the error from before the pause, so the
+/// loop resumes exactly as a loop started afresh at its frequency would.
+#[test]
+fn a_zero_amplitude_window_restarts_the_loop_as_new() {
+    let mut plant = Resonator::reference(Dynamics::InstantPhase);
+    let start = 40_600.0;
+    plant.settle(start, 0.3);
+    let settings = TrackerSettings::OPERATION;
+    let mut tracker = Tracker::new(
+        config(&settings),
+        Frequency::from_millihertz((start * 1000.0) as u32),
+        CLOCK,
+    )
+    .unwrap();
+    let a = amplitude(0.3);
+    for _ in 0..3 {
+        let drive = tracker.tuning().frequency;
+        let window = plant.window(drive, a, window_samples(drive), f64::from(FS));
+        tracker.update(&window, a).unwrap();
+    }
+    // Hundreds of hertz off resonance: the error before the pause is large.
+    let before = tracker.tuning().frequency;
+    assert!((hz(before) - 40_000.0).abs() > 100.0, "{}", hz(before));
+    let drive = tracker.tuning().frequency;
+    let paused = plant.window(drive, Amplitude::ZERO, window_samples(drive), f64::from(FS));
+    tracker.update(&paused, Amplitude::ZERO).unwrap();
+    assert_eq!(tracker.tuning().frequency, before, "the frequency holds");
+    let mut fresh = Tracker::new(
+        config(&settings),
+        Frequency::from_millihertz(tracker.command_mhz as u32),
+        CLOCK,
+    )
+    .unwrap();
+    assert_eq!(tracker, fresh);
+    let window = plant.window(drive, a, window_samples(drive), f64::from(FS));
+    tracker.update(&window, a).unwrap();
+    fresh.update(&window, a).unwrap();
+    assert_eq!(tracker.tuning(), fresh.tuning());
+}

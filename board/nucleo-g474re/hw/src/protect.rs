@@ -305,6 +305,27 @@ mod tests {
         assert_eq!(window_low_code(1 << 30, 2048), None);
     }
 
+    /// For a tared zero between two DAC steps the lower code is the exact mirror rounded
+    /// *up* (the lower comparator trips at most as late as the upper one's mirror), from an
+    /// f64 mirror: `2 * zero / 2^31 * 4096 - high`.
+    #[test]
+    fn the_window_low_code_rounds_up_for_a_zero_between_dac_steps() {
+        let high = 3599u16;
+        for zero in [
+            (1 << 30) + 1,
+            (1 << 30) + (1 << 17),
+            (1 << 30) + (1 << 18) - 1,
+            (1 << 30) + (1 << 18) + 3,
+            (1 << 30) - (1 << 16),
+            (1 << 30) - 1,
+        ] {
+            let mirror = 2.0 * f64::from(zero) / f64::from(1u32 << 31) * 4096.0 - f64::from(high);
+            assert_ne!(mirror.fract(), 0.0, "zero {zero} lies between steps");
+            let expected = mirror.ceil() as u16;
+            assert_eq!(window_low_code(zero, high), Some(expected), "zero {zero}");
+        }
+    }
+
     /// A DAC code as the current it stands for on `sense`, mA.
     fn code_ma(code: u16, sense: &ShuntAmplifier) -> i64 {
         let reading = sonolube::fx::Q1_31::from_bits(i32::from(code) << 19);
