@@ -28,7 +28,7 @@ mod tests;
 
 pub use apply::{apply, capture};
 pub use crc::crc32;
-pub use layout::{FlashLayout, G474_SINGLE_BANK};
+pub use layout::{FlashLayout, G474_DUAL_BANK, G474_SINGLE_BANK};
 pub use log::{Event, LOG_BYTES, LOG_LEN, Log};
 pub use record::{AxisCal, FREQ_RANGE_CHZ, Invalid, RECORD_LEN, RECORD_VERSION, Record};
 pub use report::{format_log, format_settings};

@@ -1,12 +1,16 @@
-//! The settings store on the G474's own flash: the last four 4 KiB pages
-//! ([`sonolube::settings::G474_SINGLE_BANK`], kept out of the code by `memory.x`), through
+//! The settings store on the G474's own flash: the last eight 2 KiB pages of bank 2
+//! ([`sonolube::settings::G474_DUAL_BANK`]; `memory.x` keeps the image in bank 1), through
 //! embassy-stm32's blocking flash driver behind embassy-embedded-hal's `BlockingAsync` adapter
-//! (the store's futures complete on their first poll). Also the board's side of the settings
-//! ([`Persistent`] for [`BoardRig`]) and the reset cause for the boot log.
+//! (the store's futures complete on their first poll) and the guard of
+//! [`sonolube_g474_hw::flash`]: no program or erase while TIM1's MOE is set, erases one page at
+//! a time with the watchdog fed before and after each page. Also the board's side of the
+//! settings ([`Persistent`] for [`BoardRig`]) and the reset cause for the boot log.
 //!
-//! The firmware is built `single-bank`: when the option bytes say dual-bank (DBANK = 1, 2 KiB
-//! pages) the store stays closed, `save` and `load` answer `storage-failed`, and the board runs
-//! with the scene's defaults (embassy's driver would panic on the mismatch).
+//! The firmware is built `dual-bank`, the G474's factory setting (option bytes 0xFFEF_F8AA,
+//! DBANK = 1): code runs from bank 1 while bank 2 is erased or programmed. When the option
+//! bytes say single-bank (DBANK = 0, someone changed them) the store stays closed, `save` and
+//! `load` answer `storage-failed`, and the board runs with the scene's defaults (embassy's
+//! driver would panic on the mismatch).
 
 use embassy_embedded_hal::adapter::BlockingAsync;
 use embassy_stm32::Peri;
@@ -16,25 +20,49 @@ use sonolube::control::Reason;
 use sonolube::fx::{Q1_31, Q16_16};
 use sonolube::protocol::{Command, ProtocolError, SceneName, SupervisorState};
 use sonolube::sense::Calibration;
-use sonolube::settings::{G474_SINGLE_BANK, Record, Store};
+use sonolube::settings::{G474_DUAL_BANK, Record, Store};
 use sonolube_app::control::ControlLoop;
 use sonolube_app::persist::Persistent;
+use sonolube_g474_hw::flash::{FlashGuard, GuardedFlash, dual_bank, outputs_enabled};
+use sonolube_g474_hw::iwdg;
 
 use crate::rig::BoardRig;
 
-/// The flash as the store sees it.
-pub type SettingsFlash = BlockingAsync<Flash<'static, Blocking>>;
+// embassy's page and word in dual-bank mode are the layout's (a single-bank build would see
+// 4 KiB pages here).
+const _: () = assert!(embassy_stm32::flash::MAX_ERASE_SIZE == G474_DUAL_BANK.page as usize);
+const _: () = assert!(embassy_stm32::flash::WRITE_SIZE == G474_DUAL_BANK.word as usize);
+const _: () = assert!(embassy_stm32::flash::FLASH_SIZE == G474_DUAL_BANK.size as usize);
 
-/// The store on the last pages, or `None` (logged) when the flash is in dual-bank mode.
+/// The board's guard: TIM1's MOE and the IWDG.
+pub struct BoardGuard;
+
+impl FlashGuard for BoardGuard {
+    fn outputs_enabled(&mut self) -> bool {
+        outputs_enabled(embassy_stm32::pac::TIM1)
+    }
+
+    /// A reload (KR = 0xAAAA); harmless before the watchdog is started (the store runs at
+    /// boot, before the control loop's first step starts it).
+    fn feed_watchdog(&mut self) {
+        iwdg::pet(embassy_stm32::pac::IWDG)
+    }
+}
+
+/// The flash as the store sees it.
+pub type SettingsFlash = GuardedFlash<BlockingAsync<Flash<'static, Blocking>>, BoardGuard>;
+
+/// The store on the last pages of bank 2, or `None` (logged) when the flash is in single-bank
+/// mode.
 pub fn open(flash: Peri<'static, FLASH>) -> Option<Store<SettingsFlash>> {
-    if embassy_stm32::pac::FLASH.optr().read().dbank() {
+    if !dual_bank(embassy_stm32::pac::FLASH) {
         defmt::error!(
-            "settings: the flash is in dual-bank mode (option bit DBANK); this build expects single-bank 4 KiB pages: no settings store"
+            "settings: the flash is in single-bank mode (option bit DBANK = 0); this build expects the factory dual-bank mode (2 KiB pages, store in bank 2): no settings store"
         );
         return None;
     }
-    let driver = BlockingAsync::new(Flash::new_blocking(flash));
-    match Store::new(driver, G474_SINGLE_BANK.store_offsets()) {
+    let driver = GuardedFlash::new(BlockingAsync::new(Flash::new_blocking(flash)), BoardGuard);
+    match Store::new(driver, G474_DUAL_BANK.store_offsets()) {
         Ok(store) => Some(store),
         Err(error) => {
             defmt::error!("settings: store refused its range: {}", error);

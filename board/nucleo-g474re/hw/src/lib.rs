@@ -11,6 +11,7 @@
 //! | [`current`] | ADC2 (drive current) at the stepped trigger phases: CCR4 table by DMA on TIM1_UP, ADC2 ring |
 //! | [`iwdg`] | the independent watchdog (50 ms on the 32 kHz LSI) |
 //! | [`clock`] | HSE start with timeout, clock security, FLASH_ACR |
+//! | [`flash`] | FLASH_OPTR.DBANK; the settings store's guard (no program or erase with MOE set, erase page by page feeding the watchdog) |
 //!
 //! Each writing function calls `hook(step)` after every register write, `step` naming the
 //! register (`"TIM1_BDTR"`). The firmware passes `&mut |_| {}`, which inlines away; the tests
@@ -24,6 +25,7 @@ pub use stm32_metapac as pac;
 pub mod adc;
 pub mod clock;
 pub mod current;
+pub mod flash;
 pub mod iwdg;
 pub mod protect;
 pub mod safe;
