@@ -7,9 +7,11 @@
 //!   brings ADC2 up (regulator, calibration, ADEN), then the hardware-glue crate programs
 //!   ADC2, the two DMA channels (DMA1 channel 2: the ring; channel 3: the CCR4 table on
 //!   TIM1_UP) and starts the sampling aligned to phase 0.
-//! - [`follow_drive`] (from [`crate::drive`], whenever CCR1 or ARR is written): rewrites the
-//!   table for the new duty and period, rotated by the updates a frequency change suppressed
-//!   ([`note_update_events`]).
+//! - [`change_timing`] (from [`crate::drive`], a new period and duty): the hardware glue's
+//!   change that loses no conversion (the table and CCR4 kept below the smaller ARR across
+//!   it), in a critical section, counting the update a change suppressed.
+//! - [`follow_drive`] (from [`crate::drive`], whenever CCR1 alone is written): rewrites the
+//!   table for the new duty, rotated by the updates frequency changes suppressed.
 //! - [`RingReader`] (the control loop): the samples since the last step, in order, the first
 //!   one a new station sees at phase 0.
 //!
@@ -83,7 +85,7 @@ pub fn start(hw: Hardware, timing: &DriveTiming) -> Result<CurrentSense, StartEr
         timing.duty_compare(Amplitude::ZERO),
     )
     .map_err(StartError::Table)?;
-    store_table(&plan::dma_order(&phases, 0));
+    plan::store_table(&TABLE, &plan::dma_order(&phases, 0));
     SKIPPED.store(0, Ordering::Relaxed);
     let addresses = plan::Addresses {
         adc_dr: pac::ADC2.dr().as_ptr() as u32,
@@ -114,15 +116,25 @@ pub fn running() -> bool {
     RUNNING.load(Ordering::Acquire)
 }
 
-/// Counts an update event that a frequency change suppressed (the table's DMA then lags the
-/// periods by one more; [`follow_drive`] rotates the table back).
-pub fn note_update_events(events: UpdateEvents) {
-    if events == UpdateEvents::OneSuppressed {
-        let skipped = SKIPPED.load(Ordering::Relaxed);
-        SKIPPED.store(skipped.wrapping_add(1) % TABLE_LEN as u8, Ordering::Relaxed);
+/// Changes TIM1's period and duty while the stepped sampling runs ([`plan::change_timing`]:
+/// no conversion lost, the table rotated by a suppressed update), in a critical section: an
+/// interrupt inside the UDIS window longer than a period would hide a counter wrap from the
+/// suppressed-update detection. A few hundred cycles.
+pub fn change_timing(
+    timing: &DriveTiming,
+    amplitude: Amplitude,
+) -> Result<(), plan::ChangeRefused> {
+    let skipped = u32::from(SKIPPED.load(Ordering::Relaxed));
+    let changed = cortex_m::interrupt::free(|_| {
+        plan::change_timing(pac::TIM1, &TABLE, timing, amplitude, skipped, &mut |_| {})
+    })?;
+    // `skipped` is below 4.
+    SKIPPED.store(changed.skipped as u8, Ordering::Relaxed);
+    if changed.events == UpdateEvents::OneSuppressed {
         let total = SUPPRESSED.load(Ordering::Relaxed);
         SUPPRESSED.store(total.saturating_add(1), Ordering::Relaxed);
     }
+    Ok(())
 }
 
 /// Update events suppressed by frequency changes since [`start`].
@@ -141,18 +153,12 @@ pub fn follow_drive(timing: &DriveTiming, amplitude: Amplitude) {
         timing.period().arr_register(),
         timing.duty_compare(amplitude),
     ) {
-        Ok(phases) => store_table(&plan::dma_order(
-            &phases,
-            u32::from(SKIPPED.load(Ordering::Relaxed)),
-        )),
+        Ok(phases) => plan::store_table(
+            &TABLE,
+            &plan::dma_order(&phases, u32::from(SKIPPED.load(Ordering::Relaxed))),
+        ),
         // `DriveTiming` keeps ARR in the band and CCR1 at most half the period: not reached.
         Err(error) => defmt::error!("current sense: no phase table ({})", error),
-    }
-}
-
-fn store_table(memory: &[u32; TABLE_LEN]) {
-    for (slot, &value) in TABLE.iter().zip(memory) {
-        slot.store(value, Ordering::Relaxed);
     }
 }
 

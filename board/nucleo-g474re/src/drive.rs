@@ -54,23 +54,20 @@ impl Drive {
 }
 
 /// Writes period and duty for `amplitude` together (update events held off during the write),
-/// and the ADC trigger: CCR4 itself until the stepped current sampling runs, the table of
-/// [`crate::current`] afterwards (an update event suppressed by the write is counted there). A
+/// and the ADC trigger: CCR4 itself until the stepped current sampling runs, afterwards
+/// [`current::change_timing`] (the table and CCR4 kept below the smaller ARR across the change,
+/// so no conversion is lost; an update event suppressed by the write is counted there). A
 /// timing whose dead time differs from the locked one is refused: logged, and the drive made
 /// safe.
 pub fn write_timing(timing: &DriveTiming, amplitude: Amplitude) {
-    let written = if current::running() {
-        tim1::write_timing_stepped(pac::TIM1, timing, amplitude, &mut |_| {})
-            .map(current::note_update_events)
-    } else {
-        tim1::write_timing(pac::TIM1, timing, amplitude, &mut |_| {})
-    };
-    match written {
-        Ok(()) => current::follow_drive(timing, amplitude),
-        Err(refused) => {
+    if current::running() {
+        if let Err(refused) = current::change_timing(timing, amplitude) {
             safe::drive_safe();
             defmt::error!("TIM1 timing refused: {}", refused);
         }
+    } else if let Err(refused) = tim1::write_timing(pac::TIM1, timing, amplitude, &mut |_| {}) {
+        safe::drive_safe();
+        defmt::error!("TIM1 timing refused: {}", refused);
     }
 }
 

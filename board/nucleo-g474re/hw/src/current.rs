@@ -34,7 +34,26 @@
 //! sample in period `p` is again at phase `p mod 4` from the second period after the rewrite
 //! (the two or three samples in between are a quarter period off: one lock-in window).
 //!
+//! # A frequency change loses no conversion
+//!
+//! CCR4's preload holds the entry the update DMA wrote for the old period, and the table in
+//! memory holds three more. An entry at or above the new ARR never makes OC4REF rise: no
+//! TRGO2, no conversion, and from then on the ring index no longer names the phase (the
+//! conversion count lags the periods). [`change_timing`] therefore keeps every compare that
+//! can become active across the change below [`trigger_limit`], the smaller of the old and
+//! new ARR: the table is first rewritten for the new period with its entries pulled below
+//! that limit, then ARR and CCR1 are written under UDIS with CCR4's preload pulled below it
+//! too, and only then is the table written unclamped. Whichever period boundary falls between
+//! these writes, every compare made active runs under an ARR above it (the model in the tests
+//! checks every frequency pair of the band on a 500 Hz grid at every such position). A pulled
+//! entry samples up to a quarter period early: the sample is there, on a slightly wrong phase,
+//! in the lock-in window the change disturbs anyway.
+//!
 //! Register layouts: RM0440 rev 8 (ADC, DMA, DMAMUX, advanced-control timer chapters).
+
+use core::sync::atomic::{AtomicU32, Ordering};
+
+use sonolube::drive::{Amplitude, DriveTiming};
 
 use crate::Step;
 use crate::adc::{AdcRunning, triggered_cfgr};
@@ -47,6 +66,7 @@ use crate::pac::bdma::vals::{Dir, Pl, Size};
 use crate::pac::dmamux::Dmamux;
 use crate::pac::timer::TimAdv;
 use crate::pac::timer::regs::{Ccr1ch, SrAdv};
+use crate::tim1::{Refused, UpdateEvents, write_timing_stepped};
 
 /// Entries of the ADC2 ring (a multiple of 4, so a ring index names a phase).
 pub const RING_LEN: usize = 16;
@@ -160,6 +180,89 @@ pub const fn dma_order(phases: &[u32; TABLE_LEN], skipped: u32) -> [u32; TABLE_L
         i += 1;
     }
     memory
+}
+
+/// The bound CCR4 must stay below across a change of TIM1_ARR from `old_arr` to `new_arr`
+/// (dithered format): the integer part of the smaller, the bound [`phase_table`] keeps its
+/// entries below for their own ARR.
+pub const fn trigger_limit(old_arr: u32, new_arr: u32) -> u32 {
+    let smaller = if old_arr < new_arr { old_arr } else { new_arr };
+    smaller & !(TICK - 1)
+}
+
+/// `phases` with every entry at or above `limit` pulled one tick below it (never below one
+/// tick), so that each is reached under either ARR of a change.
+pub const fn clamp_table(phases: &[u32; TABLE_LEN], limit: u32) -> [u32; TABLE_LEN] {
+    let below = if limit > 2 * TICK { limit - TICK } else { TICK };
+    let mut out = *phases;
+    let mut j = 0;
+    while j < TABLE_LEN {
+        if out[j] >= limit {
+            out[j] = below;
+        }
+        j += 1;
+    }
+    out
+}
+
+/// What [`change_timing`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Changed {
+    /// Whether an update event fell inside the UDIS window.
+    pub events: UpdateEvents,
+    /// Suppressed updates since the start, mod 4, this change's included (the table is
+    /// written rotated by it, [`dma_order`]).
+    pub skipped: u32,
+}
+
+/// Why [`change_timing`] wrote nothing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ChangeRefused {
+    /// No table for the new registers.
+    Table(TableError),
+    /// The timer refused the timing (another dead time).
+    Timer(Refused),
+}
+
+/// Changes TIM1's period and duty to `timing` at `amplitude` while the stepped trigger runs,
+/// losing no conversion (see "A frequency change loses no conversion" above): the table
+/// (`table`, the DMA's memory) for the new period with its entries pulled below
+/// [`trigger_limit`] of the old ARR (read from TIM1) and the new; ARR, CCR1 and CCR4's
+/// preload under UDIS ([`write_timing_stepped`]); then the table unclamped, rotated by the
+/// suppressed updates (`skipped` before, the returned count after). Run it in a critical
+/// section. Refused with nothing written when there is no table or the dead time differs.
+pub fn change_timing(
+    tim: TimAdv,
+    table: &[AtomicU32; TABLE_LEN],
+    timing: &DriveTiming,
+    amplitude: Amplitude,
+    skipped: u32,
+    hook: &mut impl FnMut(Step),
+) -> Result<Changed, ChangeRefused> {
+    let new_arr = timing.period().arr_register();
+    let phases =
+        phase_table(new_arr, timing.duty_compare(amplitude)).map_err(ChangeRefused::Table)?;
+    if tim.bdtr().read().dtg() != timing.dead_time().dtg() {
+        return Err(ChangeRefused::Timer(Refused::DeadTimeDiffers));
+    }
+    let limit = trigger_limit(tim.arr_dither().read().0, new_arr);
+    store_table(table, &dma_order(&clamp_table(&phases, limit), skipped));
+    hook("TABLE");
+    let events =
+        write_timing_stepped(tim, timing, amplitude, limit, hook).map_err(ChangeRefused::Timer)?;
+    let skipped = (skipped + u32::from(events == UpdateEvents::OneSuppressed)) % TABLE_LEN as u32;
+    store_table(table, &dma_order(&phases, skipped));
+    hook("TABLE");
+    Ok(Changed { events, skipped })
+}
+
+/// Writes the DMA's table memory.
+pub fn store_table(table: &[AtomicU32; TABLE_LEN], memory: &[u32; TABLE_LEN]) {
+    for (slot, &value) in table.iter().zip(memory) {
+        slot.store(value, Ordering::Relaxed);
+    }
 }
 
 /// The ring index the DMA writes next, from its channel's remaining count (CNDTR counts down

@@ -17,7 +17,6 @@ use embedded_storage_async::nor_flash::{
 };
 
 use crate::pac::flash::Flash;
-use crate::pac::timer::TimAdv;
 
 /// Whether the flash runs in dual-bank mode: FLASH_OPTR.DBANK (bit 22, RM0440 5.7.20), loaded
 /// from the option bytes at reset.
@@ -25,11 +24,9 @@ pub fn dual_bank(flash: Flash) -> bool {
     flash.optr().read().dbank()
 }
 
-/// Whether TIM1's outputs are enabled: BDTR.MOE (bit 15). While it is set the bridge may
+/// Whether TIM1's outputs are enabled (BDTR.MOE, bit 15): while it is set the bridge may
 /// switch, so the store must not stall the control loop.
-pub fn outputs_enabled(tim1: TimAdv) -> bool {
-    tim1.bdtr().read().moe()
-}
+pub use crate::tim1::outputs_enabled;
 
 /// What the guarded flash asks of the board.
 pub trait FlashGuard {
@@ -141,6 +138,7 @@ mod tests {
 
     use super::*;
     use crate::image::Image;
+    use crate::pac::timer::TimAdv;
 
     /// The store's eight 2 KiB pages of 8-byte words (G474_DUAL_BANK, checked below).
     type Mock = MockFlashBase<8, 8, 256>;

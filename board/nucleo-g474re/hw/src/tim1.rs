@@ -288,15 +288,23 @@ pub enum UpdateEvents {
 }
 
 /// [`write_timing`] for the stepped ADC trigger ([`crate::current`]): ARR and CCR1 under
-/// CR1.UDIS, CCR4 left to the DMA table, and the suppressed update detected. UIF is cleared
-/// first and the counter read before UDIS is set and after it is cleared: the counter went
-/// backwards (it wrapped; the window is far shorter than a period) while no update event set
-/// UIF exactly when the wrap happened with UDIS set. (A wrap before UDIS took effect or after
-/// it was cleared sets UIF.) Refused, with nothing written, as [`write_timing`].
+/// CR1.UDIS, CCR4 left to the DMA table except that its preload is pulled below
+/// `ccr4_limit` (dithered format; [`crate::current::trigger_limit`] of the old and new ARR)
+/// when it is not already: the preload holds an entry for the old period, which the next
+/// update makes active under the new ARR, and an entry at or above the new ARR never makes
+/// OC4REF rise (no TRGO2, no conversion). The suppressed update is detected too: UIF is
+/// cleared first and the counter read before UDIS is set and after it is cleared: the counter
+/// went backwards (it wrapped; the window is far shorter than a period) while no update event
+/// set UIF exactly when the wrap happened with UDIS set. (A wrap before UDIS took effect or
+/// after it was cleared sets UIF.) Refused, with nothing written, as [`write_timing`].
+///
+/// The caller runs it in a critical section: an interrupt inside the window longer than a
+/// period would hide a whole counter wrap from the CNT comparison.
 pub fn write_timing_stepped(
     tim: TimAdv,
     timing: &DriveTiming,
     amplitude: Amplitude,
+    ccr4_limit: u32,
     hook: &mut impl FnMut(Step),
 ) -> Result<UpdateEvents, Refused> {
     if tim.bdtr().read().dtg() != timing.dead_time().dtg() {
@@ -313,6 +321,13 @@ pub fn write_timing_stepped(
     tim.ccr_dither(CH1)
         .write_value(CcrDither1ch(timing.duty_compare(amplitude)));
     hook("TIM1_CCR1");
+    // CCR4 (channel index 3) in the dithered format, as the table's DMA writes it.
+    let preloaded = tim.ccr(3).read().0;
+    if preloaded >= ccr4_limit {
+        tim.ccr(3)
+            .write_value(Ccr1ch(ccr4_limit.saturating_sub(16).max(16)));
+        hook("TIM1_CCR4");
+    }
     tim.cr1().modify(|w| w.set_udis(false));
     hook("TIM1_CR1");
     let after = tim.cnt().read().cnt();

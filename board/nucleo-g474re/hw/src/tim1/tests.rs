@@ -455,10 +455,15 @@ fn stepped(count: u32, wrap: Option<(usize, bool)>) -> (UpdateEvents, Vec<(Step,
     let new = timing(47_000);
     let mut steps = Vec::new();
     let mut index = 0;
+    let limit = crate::current::trigger_limit(
+        timing(40_000).period().arr_register(),
+        new.period().arr_register(),
+    );
     let events = write_timing_stepped(
         handle,
         &new,
         Amplitude::from_ratio(1, 2).unwrap(),
+        limit,
         &mut |step| {
             // SAFETY: the image is alive; the handle's accesses are volatile and not concurrent.
             let image = unsafe { &mut *ptr };
@@ -497,7 +502,8 @@ fn the_stepped_timing_write_leaves_ccr4_to_the_dma_and_finds_a_suppressed_update
     let last = &steps[4].1;
     assert_eq!(word(last, ARR), new.period().arr_register());
     assert_eq!(word(last, CCR1_OFFSET), new.duty_compare(half));
-    // CCR4 is the table's: configure's 3/4 trigger at 40 kHz is still there.
+    // CCR4 is the table's: configure's 3/4 trigger at 40 kHz is still there (below the new
+    // ARR, so not pulled down).
     assert_eq!(
         word(last, CCR4_OFFSET),
         timing(40_000).adc_trigger_compare()
@@ -547,7 +553,13 @@ fn the_stepped_timing_write_refuses_another_dead_time() {
     let before = image.snapshot();
     let other = DriveTiming::new(Frequency::from_hz(40_000), 400, TimerClock::G474_TIM1).unwrap();
     assert_eq!(
-        write_timing_stepped(tim(&mut image), &other, Amplitude::ZERO, &mut |_| {}),
+        write_timing_stepped(
+            tim(&mut image),
+            &other,
+            Amplitude::ZERO,
+            u32::MAX,
+            &mut |_| {}
+        ),
         Err(Refused::DeadTimeDiffers)
     );
     assert_eq!(image.snapshot(), before);
