@@ -45,6 +45,11 @@ impl Drive {
         tim1::connect_pins(pac::GPIOA, pac::GPIOB, &mut |_| {});
         protect::lock_system_breaks(pac::SYSCFG, &mut |_| {});
         protect::freeze_tim1_on_halt(pac::DBGMCU, &mut |_| {});
+        // Bring-up: a debugger may halt the core without a watchdog reset (the bridge then
+        // resumes at its old duty when the core resumes: README, step 5). Field builds keep
+        // the watchdog running, so a long halt ends in a reset with the drive safe.
+        #[cfg(feature = "bringup")]
+        protect::freeze_watchdog_on_halt(pac::DBGMCU, &mut |_| {});
         Ok(Self {
             _tim: tim,
             _high_side: high_side,
@@ -65,7 +70,10 @@ pub fn write_timing(timing: &DriveTiming, amplitude: Amplitude) {
             safe::drive_safe();
             defmt::error!("TIM1 timing refused: {}", refused);
         }
-    } else if let Err(refused) = tim1::write_timing(pac::TIM1, timing, amplitude, &mut |_| {}) {
+    } else if let Err(refused) = cortex_m::interrupt::free(|_| {
+        // The UDIS window must not be stretched past a period by an interrupt.
+        tim1::write_timing(pac::TIM1, timing, amplitude, &mut |_| {})
+    }) {
         safe::drive_safe();
         defmt::error!("TIM1 timing refused: {}", refused);
     }

@@ -2,8 +2,8 @@
 //! overcurrent trips, tare the current sense, then sample the sensors, hand every load-cell
 //! pair to the control loop ([`crate::cells`]) and log them at 2 Hz.
 
-use embassy_stm32::Peri;
 use embassy_stm32::peripherals::{ADC1, DMA1_CH1, PA0, PA1, PA8, PB0, PB13, TIM1};
+use embassy_stm32::{Peri, pac};
 use embassy_time::{Duration, Instant};
 use sonolube::drive::{Amplitude, DriveLimits, DriveTiming, OvercurrentTrip};
 use sonolube::sense::{Calibration, SampleError, SensorChannel};
@@ -178,35 +178,52 @@ pub async fn run(hw: Hardware) {
     let mut logs = [ChannelLog::new(), ChannelLog::new(), ChannelLog::new()];
     let mut overruns: u32 = 0;
     let mut malformed: u32 = 0;
+    // An ADC1 overrun (its DMA missed a result; OVRMOD overwrites silently) may have rotated
+    // the DMA's place in the channel sequence: every later triplet may mix the channels. A
+    // sensor fault until reset: the current sense stays unhealthy, so the bridge stays off.
+    // (embassy clears OVR when it starts the conversions; one during the tare counts too.)
+    let mut adc1_overran = false;
     let mut next_log = Instant::now() + LOG_PERIOD;
     loop {
-        match ring.read(&mut block).await {
-            Ok(_) => match sensing::combine(&block) {
-                Some(triplet) => {
-                    for (i, &code) in triplet.iter().enumerate() {
-                        let fault = logs[i].record(&mut channels[i], i32::from(code));
-                        // A saturated or disconnected current sense stops the drive at once and
-                        // keeps the control loop from switching it on; load-cell faults are the
-                        // control loop's business (its station checks the codes itself).
-                        if i == 2 {
-                            drive::set_current_sense_healthy(fault.is_none());
-                            if fault.is_some() {
-                                safe::drive_safe();
+        let read = ring.read(&mut block).await;
+        if !adc1_overran && sonolube_g474_hw::adc::take_overrun(pac::ADC1) {
+            adc1_overran = true;
+            defmt::error!(
+                "ADC1 overran: the scan's channel order is no longer known; current sense faulty until reset, drive off"
+            );
+        }
+        if adc1_overran {
+            drive::set_current_sense_healthy(false);
+            safe::drive_safe();
+        } else {
+            match read {
+                Ok(_) => match sensing::combine(&block) {
+                    Some(triplet) => {
+                        for (i, &code) in triplet.iter().enumerate() {
+                            let fault = logs[i].record(&mut channels[i], i32::from(code));
+                            // A saturated or disconnected current sense stops the drive at once and
+                            // keeps the control loop from switching it on; load-cell faults are the
+                            // control loop's business (its station checks the codes itself).
+                            if i == 2 {
+                                drive::set_current_sense_healthy(fault.is_none());
+                                if fault.is_some() {
+                                    safe::drive_safe();
+                                }
                             }
                         }
+                        let [normal, tangential, _] = triplet;
+                        cells::publish(RawPair { normal, tangential });
                     }
-                    let [normal, tangential, _] = triplet;
-                    cells::publish(RawPair { normal, tangential });
-                }
-                None => {
-                    // A result wider than 12 bits: the ADC is not in the plan. The current is
-                    // then unknown: the drive goes safe, as for a faulty current sample.
-                    malformed = malformed.saturating_add(1);
-                    drive::set_current_sense_healthy(false);
-                    safe::drive_safe();
-                }
-            },
-            Err(_) => overruns = overruns.saturating_add(1),
+                    None => {
+                        // A result wider than 12 bits: the ADC is not in the plan. The current is
+                        // then unknown: the drive goes safe, as for a faulty current sample.
+                        malformed = malformed.saturating_add(1);
+                        drive::set_current_sense_healthy(false);
+                        safe::drive_safe();
+                    }
+                },
+                Err(_) => overruns = overruns.saturating_add(1),
+            }
         }
         #[cfg(feature = "bringup")]
         {

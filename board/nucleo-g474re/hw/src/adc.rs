@@ -165,6 +165,19 @@ pub fn check_dma_ring(
     Ok(())
 }
 
+/// Whether the ADC overran since the last call (ISR.OVR, bit 4: a conversion ended before the
+/// DMA read the previous one), clearing the flag (rc_w1: only OVR is written 1, so the other
+/// flags are left alone). With OVRMOD = 1 the new result overwrites the old one silently: a
+/// lost DMA request rotates the DMA's place in the channel sequence, so every later sample
+/// may carry another channel's code. The caller treats it as a sensor fault.
+pub fn take_overrun(adc: Adc) -> bool {
+    let overran = adc.isr().read().ovr();
+    if overran {
+        adc.isr().write(|w| w.set_ovr(true));
+    }
+    overran
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -299,5 +312,25 @@ mod tests {
         let (mut dma, mut mux) = dma_ok_image();
         mux.set_word(0x00, 6);
         assert_eq!(check(&mut dma, &mut mux), Err(DmaProblem::Request));
+    }
+
+    /// RM0440 ADC_ISR at 0x00: OVR is bit 4, cleared by writing 1; EOC (2), EOS (3) and ADRDY
+    /// (0) must not be written 1 with it.
+    #[test]
+    fn an_overrun_is_taken_once_and_only_ovr_is_cleared() {
+        let mut image = Image::new();
+        // SAFETY: the image outlives the handle.
+        let adc = unsafe { Adc::from_ptr(image.ptr()) };
+        image.set_word(0x00, 0b0_1101);
+        assert!(!take_overrun(adc));
+        assert_eq!(
+            image.word(0x00),
+            0b0_1101,
+            "nothing written without an overrun"
+        );
+        image.set_word(0x00, 0b1_1101);
+        assert!(take_overrun(adc));
+        // A RAM image keeps the written value: exactly OVR written 1.
+        assert_eq!(image.word(0x00), 1 << 4);
     }
 }

@@ -498,10 +498,14 @@ pub enum Stalled {
     TableChannel,
     /// ADC2 is not converting on triggers (ADSTART cleared).
     Adc,
+    /// ADC2 overran (ISR.OVR): a conversion was not moved to the ring, so from then on a
+    /// ring index no longer names its sample's phase.
+    Overrun,
 }
 
 /// Whether both DMA channels and ADC2 still run (a DMA transfer error disables its channel
-/// without an interrupt here).
+/// without an interrupt here) and ADC2 has not overrun (the flag stays set: a ring that lost
+/// a conversion stays stalled).
 pub fn check_running(dma: Dma, adc: Adc) -> Result<(), Stalled> {
     if !dma.ch(RING_DMA_CHANNEL).cr().read().en() {
         return Err(Stalled::RingChannel);
@@ -511,6 +515,9 @@ pub fn check_running(dma: Dma, adc: Adc) -> Result<(), Stalled> {
     }
     if !adc.cr().read().adstart() {
         return Err(Stalled::Adc);
+    }
+    if adc.isr().read().ovr() {
+        return Err(Stalled::Overrun);
     }
     Ok(())
 }

@@ -210,6 +210,15 @@ pub fn freeze_tim1_on_halt(dbgmcu: Dbgmcu, hook: &mut impl FnMut(Step)) {
     hook("DBGMCU_APB2FZR");
 }
 
+/// DBGMCU_APB1FZR1.DBG_IWDG_STOP: the watchdog stops while the core is halted by a debugger.
+/// For bring-up builds only: in a field build a halt longer than the timeout ends in a
+/// watchdog reset, which leaves the drive safe (TIM1's outputs stop with the core, but MOE
+/// stays set, so the bridge would resume switching at the old duty when the core resumes).
+pub fn freeze_watchdog_on_halt(dbgmcu: Dbgmcu, hook: &mut impl FnMut(Step)) {
+    dbgmcu.apb1lfzr().modify(|w| w.set_iwdg(true));
+    hook("DBGMCU_APB1FZR1");
+}
+
 #[cfg(test)]
 mod tests {
     use std::vec::Vec;
@@ -374,6 +383,11 @@ mod tests {
         // SAFETY: as above.
         freeze_tim1_on_halt(unsafe { Dbgmcu::from_ptr(dbg.ptr()) }, &mut |_| {});
         // RM0440 DBGMCU_APB2FZR at 0x10, DBG_TIM1_STOP bit 11.
+        assert_eq!(dbg.word(0x10), 1 << 11);
+        // SAFETY: as above.
+        freeze_watchdog_on_halt(unsafe { Dbgmcu::from_ptr(dbg.ptr()) }, &mut |_| {});
+        // RM0440 DBGMCU_APB1FZR1 at 0x08, DBG_IWDG_STOP bit 12.
+        assert_eq!(dbg.word(0x08), 1 << 12);
         assert_eq!(dbg.word(0x10), 1 << 11);
     }
 

@@ -524,8 +524,14 @@ fn a_stalled_channel_or_converter_is_named() {
     assert_eq!(check(&mut images), (Err(Stalled::RingChannel), None));
     images.dma.set_word(dma_ccr(2), ring);
     images.dma.set_word(dma_ccr(3), table);
+    let running_cr = images.adc.word(ADC_CR);
     images.adc.set_word(ADC_CR, 1 << 28 | 1);
     assert_eq!(check(&mut images).0, Err(Stalled::Adc));
+    // ADC2_ISR (0x00) OVR, bit 4 (RM0440): an overrun stalls the ring.
+    images.adc.set_word(ADC_CR, running_cr);
+    assert_eq!(check(&mut images).0, Ok(()));
+    images.adc.set_word(0x00, 1 << 4);
+    assert_eq!(check(&mut images).0, Err(Stalled::Overrun));
 }
 
 /// The current's fundamental measured from the four samples the table takes, by the core's
