@@ -365,6 +365,18 @@ mod tests {
             code_ma(dc, &DC_LINK_SENSE)
         );
         assert_eq!((high, low, dc), (3599, 497, 3537));
+        // The same codes from the schematic's numbers in f64, not from the code: the trip
+        // voltage `zero + shunt x gain x I` on the 12-bit DAC's 3.3 V scale, rounded towards
+        // the zero current, so that each comparator trips at most at the requested current
+        // (down for the upper thresholds, up for the window's lower one at -2.5 A).
+        let exact = |sense: &ShuntAmplifier, amps: f64| {
+            let volts = f64::from(sense.zero_millivolt) / 1e3
+                + f64::from(sense.shunt_micro_ohm) / 1e6 * f64::from(sense.gain_milli) / 1e3 * amps;
+            volts / (f64::from(sense.full_scale_millivolt) / 1e3) * 4096.0
+        };
+        assert_eq!(f64::from(high), exact(&STACK_SENSE, 2.5).floor());
+        assert_eq!(f64::from(low), exact(&STACK_SENSE, -2.5).ceil());
+        assert_eq!(f64::from(dc), exact(&DC_LINK_SENSE, 6.0).floor());
         // Never later than asked: |trip| at most the requested current.
         assert!((2490..=2500).contains(&code_ma(high, &STACK_SENSE)));
         assert!((-2500..=-2490).contains(&code_ma(low, &STACK_SENSE)));
