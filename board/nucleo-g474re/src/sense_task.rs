@@ -65,6 +65,9 @@ pub async fn run(hw: Hardware) {
         }
     };
     log_timing(&timing);
+    // Both ADCs are brought up before either converts: each `Adc::new` writes the ADC12
+    // common prescaler, which must not change while a conversion runs (review finding 8).
+    let adc1 = sensing::bring_up(hw.adc);
     // The stepped current sampling first: it stops TIM1's counter for a few microseconds to
     // align period 0 with phase 0, before ADC1 takes triggers.
     let _current = match current::start(hw.current, &timing) {
@@ -119,7 +122,7 @@ pub async fn run(hw: Hardware) {
         SensorChannel::new(config::ADC_FORMAT, config::CURRENT_LIMITS, nominal_current),
     ];
     let mut ring = match sensing::start(
-        hw.adc,
+        adc1,
         hw.normal_force,
         hw.tangential_force,
         hw.drive_current,

@@ -51,21 +51,13 @@ pub enum StartError {
 
 /// ADC1 set up for one TIM1-triggered scan per PWM period, DMA-buffered, and started.
 pub fn start(
-    adc: Peri<'static, ADC1>,
+    adc: Adc<'static, ADC1>,
     normal: Peri<'static, PA0>,
     tangential: Peri<'static, PB0>,
     current: Peri<'static, PA1>,
     dma: Peri<'static, DMA1_CH1>,
 ) -> Result<RingBufferedAdc<'static, ADC1>, StartError> {
-    // embassy brings the ADC up (regulator, calibration, ADEN) and sets the DMA ring; the plan
-    // then writes every field it relies on, with ADSTART = 0, before the ring starts.
-    let adc = Adc::new(
-        adc,
-        AdcConfig {
-            resolution: Some(Resolution::BITS12),
-            ..AdcConfig::default()
-        },
-    );
+    // The plan writes every field it relies on, with ADSTART = 0, before the ring starts.
     let sample_time = SampleTime::CYCLES24_5;
     let sequence = [
         (normal.degrade_adc(), sample_time),
@@ -86,6 +78,22 @@ pub fn start(
     plan::check_dma_ring(pac::DMA1, 0, pac::DMAMUX1, pac::ADC1.dr().as_ptr() as u32)
         .map_err(StartError::Dma)?;
     Ok(ring)
+}
+
+/// ADC1 brought up by embassy (regulator, calibration, ADEN), not converting. Call it before
+/// ADC2's sampling starts: each `Adc::new` writes the ADC12 common prescaler
+/// (ADC12_CCR.PRESC), so both are created before either converts. RM0440 asks for every ADC of
+/// the pair disabled at such a write; embassy enables ADC1 in its `new`, so ADC2's `new` still
+/// writes PRESC (the same value) with ADC1 enabled but idle: not shown harmless here (board
+/// README, review finding 8).
+pub fn bring_up(adc: Peri<'static, ADC1>) -> Adc<'static, ADC1> {
+    Adc::new(
+        adc,
+        AdcConfig {
+            resolution: Some(Resolution::BITS12),
+            ..AdcConfig::default()
+        },
+    )
 }
 
 /// The triplet of one read: per channel, the two scans' 12-bit results summed into the 16-bit
