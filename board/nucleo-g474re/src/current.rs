@@ -162,9 +162,25 @@ pub fn follow_drive(timing: &DriveTiming, amplitude: Amplitude) {
     }
 }
 
+/// Realigns the table after `lost` conversions (mod 4) were lost: rotated as if the
+/// suppressed updates were `lost` fewer ([`plan::realigned`]).
+fn realign_table(lost: u32) {
+    cortex_m::interrupt::free(|_| {
+        let memory: [u32; TABLE_LEN] = core::array::from_fn(|i| TABLE[i].load(Ordering::Relaxed));
+        plan::store_table(&TABLE, &plan::realigned(&memory, lost));
+        let skipped = u32::from(SKIPPED.load(Ordering::Relaxed));
+        // Below 4.
+        SKIPPED.store(
+            ((skipped + TABLE_LEN as u32 - lost % TABLE_LEN as u32) % TABLE_LEN as u32) as u8,
+            Ordering::Relaxed,
+        );
+    });
+}
+
 /// The control loop's position in the ring.
 pub struct RingReader {
     read: usize,
+    audit: plan::ConversionAudit,
 }
 
 impl RingReader {
@@ -174,6 +190,7 @@ impl RingReader {
         let write = plan::ring_write_index(pac::DMA1).filter(|_| running())?;
         Some(Self {
             read: plan::aligned_start(write),
+            audit: plan::ConversionAudit::default(),
         })
     }
 
@@ -200,6 +217,20 @@ impl RingReader {
             }
         }
         self.read = write;
+        // The DMA counts against each other: a lost conversion (one the frequency change's
+        // clamp did not prevent) is found and the table realigned. Ring count first.
+        let ring_remaining = pac::DMA1.ch(plan::RING_DMA_CHANNEL).ndtr().read().ndt();
+        let table_remaining = pac::DMA1.ch(plan::TABLE_DMA_CHANNEL).ndtr().read().ndt();
+        let skipped = u32::from(SKIPPED.load(Ordering::Relaxed));
+        if let Some(lost) = self.audit.observe(ring_remaining, table_remaining, skipped)
+            && lost != 0
+        {
+            realign_table(lost);
+            defmt::warn!(
+                "current sense: {=u32} conversion(s) lost (DMA counts); table realigned",
+                lost
+            );
+        }
         Ok(count)
     }
 }

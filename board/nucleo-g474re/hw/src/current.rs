@@ -258,6 +258,75 @@ pub fn change_timing(
     Ok(Changed { events, skipped })
 }
 
+/// Lost conversions found from the two DMA counts, for a realignment of the table.
+///
+/// Period `p` of the stepped trigger starts with the update that makes the table channel's
+/// transfer count `T = p - s` (`s`: the updates frequency changes suppressed) and ends after
+/// its conversion, which makes the ring's count `C = p + 1 - L` (`L`: conversions lost since the
+/// start). So `X = T + s - C` (mod 4) is `L` between a period's update and its conversion and
+/// `L - 1` after it: read the ring's count first and the table's second, and an update or a
+/// conversion between the two reads still gives one of these two values. One value alone is
+/// ambiguous (the firmware cannot read CCR4's active register to know which half of the period
+/// it read in); once both adjacent values have been seen, `L` is the larger (mod 4). The board
+/// observes once per control step, whose phase to the PWM period drifts at every frequency
+/// but exact submultiples of the control rate.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ConversionAudit {
+    /// Bit `x` set: `X = x` was observed since the last verdict.
+    seen: u8,
+}
+
+impl ConversionAudit {
+    /// One observation: `ring_remaining` (the ring channel's CNDTR, read first),
+    /// `table_remaining` (the table channel's CNDTR, read second) and the suppressed updates
+    /// mod 4. `Some(L)`: the conversions lost mod 4 (0: none), once both values of the pair
+    /// have been seen; the audit then starts afresh. None: not yet decided, or a count the
+    /// channels cannot have.
+    pub fn observe(
+        &mut self,
+        ring_remaining: u16,
+        table_remaining: u16,
+        skipped: u32,
+    ) -> Option<u32> {
+        let converted = write_index(ring_remaining)? as u32;
+        let table_remaining = u32::from(table_remaining);
+        if table_remaining == 0 || table_remaining > TABLE_LEN as u32 {
+            return None;
+        }
+        let transfers = (TABLE_LEN as u32 - table_remaining) % TABLE_LEN as u32;
+        let x = (transfers + skipped % 4 + RING_LEN as u32 - converted % 4) % TABLE_LEN as u32;
+        self.seen |= 1 << x;
+        match self.seen.count_ones() {
+            1 => None,
+            2 => {
+                // The pair {L - 1, L}: L is the value whose predecessor (mod 4) was seen too.
+                let lost = (0..TABLE_LEN as u32)
+                    .find(|&l| self.seen & (1 << l) != 0 && self.seen & (1 << ((l + 3) % 4)) != 0);
+                self.seen = 0;
+                // Two values that are not adjacent cannot happen: start afresh.
+                lost
+            }
+            _ => {
+                self.seen = 1 << x;
+                None
+            }
+        }
+    }
+}
+
+/// The table memory rotated so that the ring index names the phase again after `lost`
+/// conversions (mod 4) were lost: as [`dma_order`] with the suppressed updates lowered by
+/// `lost` (entry `i` takes entry `i - lost`).
+pub const fn realigned(memory: &[u32; TABLE_LEN], lost: u32) -> [u32; TABLE_LEN] {
+    let mut out = [0u32; TABLE_LEN];
+    let mut i = 0;
+    while i < TABLE_LEN {
+        out[i] = memory[(i + TABLE_LEN - lost as usize % TABLE_LEN) % TABLE_LEN];
+        i += 1;
+    }
+    out
+}
+
 /// Writes the DMA's table memory.
 pub fn store_table(table: &[AtomicU32; TABLE_LEN], memory: &[u32; TABLE_LEN]) {
     for (slot, &value) in table.iter().zip(memory) {
