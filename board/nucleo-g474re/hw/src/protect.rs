@@ -258,6 +258,38 @@ mod tests {
         }
     }
 
+    /// Which DAC channel each comparator's INMSEL code selects on the STM32G474 (RM0440,
+    /// COMPx inverting input assignment; the same in ST's HAL `COMP_INPUT_MINUS_DACx_CHy`
+    /// comments): code 0b100 ("DACA") and 0b101 ("DACB") per comparator. The board writes the
+    /// thresholds to DAC3_CH1 (COMP1), DAC1_CH1 (COMP3) and DAC4_CH2 (COMP6): each setup's code
+    /// must select exactly that channel.
+    #[test]
+    fn each_comparator_selects_the_dac_channel_its_threshold_is_written_to() {
+        const ASSIGNMENT: [(u8, &str, &str); 7] = [
+            (1, "DAC3_CH1", "DAC1_CH1"),
+            (2, "DAC3_CH2", "DAC1_CH2"),
+            (3, "DAC3_CH1", "DAC1_CH1"),
+            (4, "DAC3_CH2", "DAC1_CH1"),
+            (5, "DAC4_CH1", "DAC1_CH2"),
+            (6, "DAC4_CH2", "DAC2_CH1"),
+            (7, "DAC4_CH1", "DAC2_CH1"),
+        ];
+        for (comp, setup, written_to) in [
+            (1u8, STACK_HIGH, "DAC3_CH1"),
+            (3, STACK_LOW, "DAC1_CH1"),
+            (6, DC_LINK, "DAC4_CH2"),
+        ] {
+            let (image, _) = comp_image(setup);
+            let (_, daca, dacb) = ASSIGNMENT[usize::from(comp - 1)];
+            let selected = match image.bits(0, 4, 3) {
+                0b100 => daca,
+                0b101 => dacb,
+                other => panic!("COMP{comp}: INMSEL {other:#b} is no DAC"),
+            };
+            assert_eq!(selected, written_to, "COMP{comp}");
+        }
+    }
+
     #[test]
     fn threshold_dacs_are_internal_unbuffered_with_hfsel() {
         for channel in [0usize, 1] {
