@@ -234,9 +234,25 @@ impl MotorScene {
         })
     }
 
+    /// The two groups the force depends on at `shape` and `amplitude` (Q1.31, [0, 1)):
+    /// k = a K0 cos(pi x/L) in [0, 8] and the peak face speed w = a A omega |sin(pi x/L)| in
+    /// m/s, [0, 128), both Q8.24, rounded to nearest (a negative amplitude counts as 0).
+    pub fn groups(&self, shape: &HornShape, amplitude: Q1_31) -> (Q8_24, Q8_24) {
+        let a = amplitude.to_bits().max(0) as i64;
+        let scale = |full: Q8_24, shape: i64| {
+            let scaled = (full.to_bits() as i64 * a + (1 << 30)) >> 31;
+            Q8_24::from_bits(((scaled * shape + (1 << 30)) >> 31) as i32)
+        };
+        let cos_shape = (shape.cos_shape.to_bits() as i64).max(0);
+        let sin_shape = (shape.sin_shape.to_bits() as i64).abs();
+        (
+            scale(self.decay, cos_shape),
+            scale(self.face_speed, sin_shape),
+        )
+    }
+
     /// phi in Q.30, in [-2^30, 2^30].
     fn drive_ratio(&self, point: &MotorPoint, amplitude: Q1_31) -> Result<i64, ModelError> {
-        let a = amplitude.to_bits().max(0) as i64;
         let sin_shape = point.shape.sin_shape.to_bits() as i64;
         let cos_shape = point.shape.cos_shape.to_bits() as i64;
         if cos_shape < 0 {
@@ -245,13 +261,8 @@ impl MotorScene {
                 reason: "|x| must be <= L/2",
             });
         }
-        let scale = |full: Q8_24, shape: i64| {
-            let scaled = (full.to_bits() as i64 * a + (1 << 30)) >> 31;
-            (scaled * shape + (1 << 30)) >> 31
-        };
-        // k = a K0 cos(pi x/L) <= 8 and w = a A omega |sin(pi x/L)| < 128 m/s, Q8.24.
-        let k = scale(self.decay, cos_shape);
-        let w = scale(self.face_speed, sin_shape.abs());
+        let (k, w) = self.groups(&point.shape, amplitude);
+        let (k, w) = (k.to_bits() as i64, w.to_bits() as i64);
         let s: i64 = if sin_shape < 0 { -1 } else { 1 };
         let v = point.block_velocity.to_bits() as i64;
         if w == 0 {
