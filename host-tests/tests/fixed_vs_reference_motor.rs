@@ -177,3 +177,70 @@ proptest! {
         prop_assert!(check(&map, phase).is_ok(), "{}", check(&map, phase).unwrap_err());
     }
 }
+
+/// Holding a block still against an external load (net force zero): the fixed-point inversion's
+/// amplitude, fed to the reference (A and B scaled by it), gives a net force within 5 mN of
+/// zero, at seed 001's positions and loads, for every reachable pull.
+#[test]
+fn held_block_against_an_external_load_nets_zero_in_the_reference() {
+    use sonolube::fx::{Q8_24, Q16_16};
+    use sonolube::model::Reach;
+    use sonolube::model::horn::{HornShape, UPhase};
+    use sonolube::model::motor::{MotorParams, MotorPoint, MotorScene};
+    let scene = MotorScene::new(
+        &MotorParams {
+            friction_coefficient: 0.55,
+            longitudinal_amplitude: 11.46e-6,
+            vertical_amplitude: 1.1e-6,
+            horn_length: 0.127,
+            frequency: 20e3,
+            roughness_rq: 6e-6,
+            distribution_lambda: 3.0,
+        },
+        UPhase::Quadrature,
+    )
+    .unwrap();
+    let mut reached = 0;
+    for x in [
+        -1.5 * INCH,
+        -INCH,
+        -0.5 * INCH,
+        0.3 * INCH,
+        INCH,
+        1.5 * INCH,
+    ] {
+        for load in [60.0, 120.0, 240.0] {
+            for pull in [0.5, 2.0, 5.0, 10.0, 20.0, 40.0] {
+                // The external load pulls the block away from the centreline.
+                let external = x.signum() * pull;
+                let point = MotorPoint {
+                    shape: HornShape::new(x, 0.127).unwrap(),
+                    normal_force: Q16_16::from_f64(load).unwrap(),
+                    block_velocity: Q8_24::ZERO,
+                };
+                let out = scene
+                    .amplitude_for_force(&point, Q16_16::from_f64(-external).unwrap())
+                    .unwrap();
+                let a = out.amplitude.to_f64();
+                let map = inputs(&[
+                    ("x", x),
+                    ("F_n", load),
+                    ("A", 11.46e-6 * a),
+                    ("B", 1.1e-6 * a),
+                ]);
+                let reference = eval_named("motor_force", &map, &BTreeMap::new()).unwrap();
+                match out.reach {
+                    Reach::Reached => {
+                        reached += 1;
+                        let net = reference["F_t"] + external;
+                        assert!(net.abs() < 5e-3, "x {x} load {load} pull {pull}: net {net}");
+                    }
+                    // Beyond the full-amplitude force: the reference agrees it is out of reach.
+                    Reach::BelowMinimum => assert!(reference["F_t"].abs() < pull),
+                    Reach::AboveNatural => panic!("a pull away from the centre is reachable"),
+                }
+            }
+        }
+    }
+    assert!(reached > 50, "{reached}");
+}

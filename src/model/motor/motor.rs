@@ -56,11 +56,11 @@ use core::f64::consts::PI;
 
 use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16, cos};
 
-use super::ModelError;
 use super::contact_constants::{non_negative, positive};
 use super::fx_error;
 use super::horn::{HornShape, UPhase};
 use super::quadrature::legendre_half;
+use super::{ModelError, Reach};
 
 /// Gauss-Legendre points per piece (a piece spans at most a quarter period).
 pub const MOTOR_QUADRATURE_POINTS: usize = 12;
@@ -114,6 +114,18 @@ pub struct MotorForce {
     pub drive_ratio: Q2_30,
     /// F_t = phi mu F_n in N along +x (towards +x positive), Q16.16.
     pub force: Q16_16,
+}
+
+/// Result of [`MotorScene::amplitude_for_force`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ForceInversion {
+    /// Drive amplitude, Q1.31 fraction of full scale in [0, 1).
+    pub amplitude: Q1_31,
+    /// The force the model gives at `amplitude`.
+    pub force: MotorForce,
+    /// Whether the target was reachable.
+    pub reach: Reach,
 }
 
 /// Where the block is and how it is loaded.
@@ -251,6 +263,78 @@ impl MotorScene {
         )
     }
 
+    /// The drive amplitude at which the net tangential force on the block equals `target`
+    /// (N along +x, Q16.16, either sign): to hold a block still against an external load
+    /// F_ext, `target = -F_ext` (net force zero). Bisection over the amplitude, 16 halvings
+    /// (2^-16 of full scale; about 0.4 mN at 120 N for seed 001's horn).
+    ///
+    /// The force's component towards the centreline, -sgn(x) F_t, grows with the amplitude
+    /// for a held block (L0(k) / I0(k) increases with k) and for a block moving towards the
+    /// centreline (the face outruns it over a longer part of the period); for a block moving
+    /// away from the centreline it is not monotone (plain friction towards the centre at low
+    /// amplitude, the smaller motor force beyond the Littmann edge), and the inversion is
+    /// refused with `OutOfDomain` rather than answered wrongly. At the node (sin(pi x/L) = 0)
+    /// the force towards +x is taken as the centre direction (it is 0 for a held block at
+    /// every amplitude). Reach: `AboveNatural` with amplitude 0 when the target's component
+    /// towards the centre is at or below the force without vibration; `BelowMinimum` with
+    /// full amplitude when it is beyond the force at full amplitude (flagged, never clamped
+    /// silently). Errors: as [`Self::force`].
+    pub fn amplitude_for_force(
+        &self,
+        point: &MotorPoint,
+        target: Q16_16,
+    ) -> Result<ForceInversion, ModelError> {
+        let s: i64 = if point.shape.sin_shape.to_bits() < 0 {
+            -1
+        } else {
+            1
+        };
+        if s * point.block_velocity.to_bits() as i64 > 0 {
+            return Err(ModelError::OutOfDomain {
+                input: "v_b",
+                reason: "the block moves away from the centreline: its force is not monotone \
+                         in the amplitude",
+            });
+        }
+        // Components towards the centreline, Q16.16 bits.
+        let towards = |force: Q16_16| -s * force.to_bits() as i64;
+        let wanted = towards(target);
+        let none = self.force(point, Q1_31::ZERO)?;
+        if wanted <= towards(none.force) {
+            return Ok(ForceInversion {
+                amplitude: Q1_31::ZERO,
+                force: none,
+                reach: Reach::AboveNatural,
+            });
+        }
+        let full = self.force(point, Q1_31::MAX)?;
+        if wanted >= towards(full.force) {
+            return Ok(ForceInversion {
+                amplitude: Q1_31::MAX,
+                force: full,
+                reach: Reach::BelowMinimum,
+            });
+        }
+        // Invariant: towards(force(low)) < wanted <= towards(force(high)).
+        let (mut low, mut high) = (0i32, Q1_31::MAX.to_bits());
+        let mut at_high = full;
+        for _ in 0..super::BISECTION_STEPS {
+            let mid = low + (high - low) / 2;
+            let force = self.force(point, Q1_31::from_bits(mid))?;
+            if towards(force.force) < wanted {
+                low = mid;
+            } else {
+                high = mid;
+                at_high = force;
+            }
+        }
+        Ok(ForceInversion {
+            amplitude: Q1_31::from_bits(high),
+            force: at_high,
+            reach: Reach::Reached,
+        })
+    }
+
     /// phi in Q.30, in [-2^30, 2^30].
     fn drive_ratio(&self, point: &MotorPoint, amplitude: Q1_31) -> Result<i64, ModelError> {
         let sin_shape = point.shape.sin_shape.to_bits() as i64;
@@ -363,9 +447,37 @@ pub const STAINLESS_HORN_REGIONS: MeasuredRegions = MeasuredRegions {
     motor_outer: (-1.5 * INCH, 1.5 * INCH),
 };
 
+/// Which of seed 001's regions a position lies in, and so which model describes the block.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum HornRegion {
+    /// Inside the measured transition region: friction reduction, the cube model.
+    Transition,
+    /// In a motor-effect region: the net drive force, this module's model.
+    Motor,
+    /// Beyond the measured motor regions (Table 1 stops at +-1.5 in): the motor model is
+    /// still evaluated (it runs to the horn's ends) but no measurement backs it.
+    BeyondMeasured,
+}
+
 impl MeasuredRegions {
     /// Whether `x` (m from the centre) lies in the measured transition region (inclusive).
     pub fn in_transition(&self, x: f64) -> bool {
         self.transition.0 <= x && x <= self.transition.1
+    }
+
+    /// The region of position `x` (m from the centre): the model choice by where the block is.
+    /// A non-finite `x` is [`ModelError::NonFinite`].
+    pub fn region(&self, x: f64) -> Result<HornRegion, ModelError> {
+        if !x.is_finite() {
+            return Err(ModelError::NonFinite { input: "x" });
+        }
+        Ok(if self.in_transition(x) {
+            HornRegion::Transition
+        } else if self.motor_outer.0 <= x && x <= self.motor_outer.1 {
+            HornRegion::Motor
+        } else {
+            HornRegion::BeyondMeasured
+        })
     }
 }

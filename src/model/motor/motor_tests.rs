@@ -210,3 +210,90 @@ fn bad_scene_inputs_are_reported() {
         );
     }
 }
+
+#[test]
+fn model_choice_follows_table_1() {
+    use super::motor::HornRegion;
+    let al = ALUMINIUM_HORN_REGIONS;
+    assert_eq!(al.region(0.0).unwrap(), HornRegion::Transition);
+    assert_eq!(al.region(-0.006).unwrap(), HornRegion::Transition);
+    assert_eq!(al.region(-0.0254).unwrap(), HornRegion::Motor);
+    assert_eq!(al.region(0.007).unwrap(), HornRegion::Motor);
+    assert_eq!(al.region(0.05).unwrap(), HornRegion::BeyondMeasured);
+    // The stainless horn's transition region is off centre: the centre itself is a motor point.
+    assert_eq!(
+        STAINLESS_HORN_REGIONS.region(0.0).unwrap(),
+        HornRegion::Motor
+    );
+    assert!(al.region(f64::NAN).is_err());
+}
+
+#[test]
+fn holding_a_block_against_an_external_load() {
+    use super::Reach;
+    let scene = MotorScene::new(&seed_params(), UPhase::Quadrature).unwrap();
+    // Block held at -1 in (seed 001 Fig. 4a) under 120 N, pulled outwards (-x) by 10 N: the
+    // drive must push +10 N towards the centre for a net force of zero.
+    let held = point(-0.0254, 120.0, 0.0);
+    let external = 10.0;
+    let out = scene
+        .amplitude_for_force(&held, Q16_16::from_f64(-(-external)).unwrap())
+        .unwrap();
+    assert_eq!(out.reach, Reach::Reached);
+    let net = out.force.force.to_f64() - external;
+    assert!(net.abs() < 2e-3, "net {net}");
+    // The amplitude found is the model's: the force there, recomputed, is the same.
+    let again = scene.force(&held, out.amplitude).unwrap();
+    assert_eq!(again, out.force);
+    // More than the full-amplitude motor force (18.2 N): full drive, flagged.
+    let too_much = scene
+        .amplitude_for_force(&held, Q16_16::from_f64(25.0).unwrap())
+        .unwrap();
+    assert_eq!(too_much.reach, Reach::BelowMinimum);
+    assert_eq!(too_much.amplitude, Q1_31::MAX);
+    // A pull towards the outside would need the drive to push away from the centre: the
+    // vibration cannot, amplitude 0 (no vibration: the external load meets static friction).
+    let outward = scene
+        .amplitude_for_force(&held, Q16_16::from_f64(-5.0).unwrap())
+        .unwrap();
+    assert_eq!(outward.reach, Reach::AboveNatural);
+    assert_eq!(outward.amplitude, Q1_31::ZERO);
+    // A block moving away from the centre: refused, not answered wrongly.
+    assert!(
+        scene
+            .amplitude_for_force(
+                &point(-0.0254, 120.0, -0.005),
+                Q16_16::from_f64(5.0).unwrap()
+            )
+            .is_err()
+    );
+    // Moving towards the centre at 5 mm/s: monotone, reachable.
+    let inward = scene
+        .amplitude_for_force(
+            &point(-0.0254, 120.0, 0.005),
+            Q16_16::from_f64(10.0).unwrap(),
+        )
+        .unwrap();
+    assert_eq!(inward.reach, Reach::Reached);
+    assert!((inward.force.force.to_f64() - 10.0).abs() < 2e-3);
+}
+
+#[test]
+fn force_towards_the_centre_grows_with_the_amplitude() {
+    let scene = MotorScene::new(&seed_params(), UPhase::Quadrature).unwrap();
+    for (x, v_b) in [
+        (-0.0254, 0.0),
+        (0.0254, 0.0),
+        (-0.0254, 0.005),
+        (0.01, -0.005),
+    ] {
+        let p = point(x, 120.0, v_b);
+        let mut last = f64::NEG_INFINITY;
+        for step in 0..=64 {
+            let a = Q1_31::from_bits(((step as i64 * Q1_31::MAX.to_bits() as i64) / 64) as i32);
+            let towards = -x.signum() * scene.force(&p, a).unwrap().force.to_f64();
+            assert!(towards >= last - 1e-4, "x {x} v {v_b} step {step}");
+            last = towards;
+        }
+    }
+}
