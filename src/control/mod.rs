@@ -156,7 +156,9 @@ pub use schedule::{Boost, GainSchedule};
 pub use shaper::{DriveShaper, Shaped, ShaperConfig, ShaperError};
 pub use sliding::{SlidingConfig, SlidingDetector};
 pub use supervisor::{Contact, RampConfig, Supervisor};
-pub use target::{ForceQ, PreparedTarget};
+pub use target::{
+    ForceQ, HoldStep, NET_FORCE_MAX_MN, NetForceHold, NetForceTarget, PreparedTarget,
+};
 pub use tuning::{
     FAST_GAINS, FORCE_FILTER_HZ, NATURAL_LEARN_S, NATURAL_PRIOR_WEIGHT, SLIDING_DEBOUNCE_S,
     STEADY_GAINS, VELOCITY_FILTER_HZ, controller_settings,
