@@ -50,7 +50,8 @@
 //! `Overflow` when |F_t| >= 32768 N, never a wrap. P + M >= e^(-k) I0(k) >= 0.13 for k <= 8: the
 //! division is well conditioned.
 //!
-//! Cost: one `asin`, and per node one `cos` and one `exp_neg`: 3 to 5 pieces of 12 nodes.
+//! Cost: one `asin`, and per node one `cos` and one `exp_neg`: 4 or 5 pieces of 12 nodes (none
+//! when the block outruns the face). Not yet measured in QEMU (`docs/speed.md` has no row).
 
 use core::f64::consts::PI;
 
@@ -65,9 +66,11 @@ use super::{ModelError, Reach};
 /// Gauss-Legendre points per piece (a piece spans at most a quarter period).
 pub const MOTOR_QUADRATURE_POINTS: usize = 12;
 
-/// Largest accepted contact group K0 = lambda B / R_q. Beyond it the normal force is a spike
-/// narrower than the rule resolves (error above 1e-6 of mu F_n against the reference); seed 000
-/// Table 1 gives 0.55 (B = 1.1 um, R_q = 6 um, lambda = 3).
+/// Largest accepted contact group K0 = lambda B / R_q: the range over which the rule is checked
+/// against the reference (within 1e-6 of mu F_n at 8, `motor_tests` and host-tests). The normal
+/// force narrows to a spike of width about 1 / sqrt(K0) around the closest approach as K0
+/// grows, which a fixed rule resolves ever worse. Seed 000 Table 1 gives 0.55 (B = 1.1 um,
+/// R_q = 6 um, lambda = 3): 15 times below the limit.
 pub const MAX_DECAY: f64 = 8.0;
 
 /// Scene inputs of the motor model, SI units.
