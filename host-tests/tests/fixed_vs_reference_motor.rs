@@ -244,3 +244,39 @@ fn held_block_against_an_external_load_nets_zero_in_the_reference() {
     }
     assert!(reached > 50, "{reached}");
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// The physics the inversion and the comparison with seed 001 rely on, in the reference
+    /// alone: for a block held or moving towards the centreline, the force towards the centre
+    /// grows with the drive amplitude (A and B scaled together) and, for a held block, is
+    /// positive off the node and the ends; and the force is exactly linear in the load.
+    #[test]
+    fn reference_force_points_to_the_centre_and_grows_with_the_amplitude(
+        x in prop_oneof![-0.06f64..-1e-5, 1e-5f64..0.06],
+        inward in prop_oneof![Just(0.0), 0.0f64..0.05],
+        load in 1.0f64..2000.0,
+        b in 0.1e-6f64..8e-6,
+    ) {
+        let v_b = -x.signum() * inward; // towards the centre
+        let towards = |scale: f64, load: f64| {
+            let map = inputs(&[("x", x), ("v_b", v_b), ("F_n", load),
+                               ("A", 11.46e-6 * scale), ("B", b * scale)]);
+            -x.signum() * eval_named("motor_force", &map, &BTreeMap::new()).unwrap()["F_t"]
+        };
+        let mut last = f64::NEG_INFINITY;
+        for step in 0..=16 {
+            let now = towards(step as f64 / 16.0, load);
+            prop_assert!(now >= last - 1e-9 * load, "x {x} v {v_b} step {step}: {now} < {last}");
+            last = now;
+        }
+        if inward == 0.0 {
+            // Held: towards the centre at full amplitude (moving, the block may outrun the
+            // face and feel plain friction outwards).
+            prop_assert!(last > 0.0, "x {x}: {last}");
+        }
+        let (one, two) = (towards(1.0, load), towards(1.0, 2.0 * load));
+        prop_assert!((two - 2.0 * one).abs() <= 1e-12 * load, "linear in F_n");
+    }
+}
