@@ -118,6 +118,7 @@ mod estimate;
 mod filter;
 mod io;
 mod limits;
+mod net_force;
 mod pi;
 mod reason;
 mod recip;
@@ -149,6 +150,7 @@ pub use estimate::{
 pub use filter::{FilterError, LowPass, LowPassCoef};
 pub use io::{Inputs, Output, Saturation};
 pub use limits::{ActuatorRatings, AmplitudeLimit, Binding, LimitsError};
+pub use net_force::{HoldStep, NET_FORCE_MAX_MN, NetForceHold, NetForceTarget};
 pub use pi::{Clamp, GainsError, Pi, PiCandidate, PiGains};
 pub use reason::{ExternalFault, Reason, Sensor, SensorFault, SensorFaultKind};
 pub use recip::Reciprocal;
@@ -156,9 +158,7 @@ pub use schedule::{Boost, GainSchedule};
 pub use shaper::{DriveShaper, Shaped, ShaperConfig, ShaperError};
 pub use sliding::{SlidingConfig, SlidingDetector};
 pub use supervisor::{Contact, RampConfig, Supervisor};
-pub use target::{
-    ForceQ, HoldStep, NET_FORCE_MAX_MN, NetForceHold, NetForceTarget, PreparedTarget,
-};
+pub use target::{ForceQ, PreparedTarget};
 pub use tuning::{
     FAST_GAINS, FORCE_FILTER_HZ, NATURAL_LEARN_S, NATURAL_PRIOR_WEIGHT, SLIDING_DEBOUNCE_S,
     STEADY_GAINS, VELOCITY_FILTER_HZ, controller_settings,

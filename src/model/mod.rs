@@ -97,6 +97,8 @@ pub mod horn;
 pub mod littmann;
 #[path = "motor/motor.rs"]
 pub mod motor;
+#[path = "motor/motor_regions.rs"]
+pub mod motor_regions;
 #[cfg(test)]
 #[path = "motor/motor_tests.rs"]
 mod motor_tests;
