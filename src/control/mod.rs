@@ -118,6 +118,7 @@ mod estimate;
 mod filter;
 mod io;
 mod limits;
+mod net_force;
 mod pi;
 mod reason;
 mod recip;
@@ -149,6 +150,7 @@ pub use estimate::{
 pub use filter::{FilterError, LowPass, LowPassCoef};
 pub use io::{Inputs, Output, Saturation};
 pub use limits::{ActuatorRatings, AmplitudeLimit, Binding, LimitsError};
+pub use net_force::{HoldStep, NET_FORCE_MAX_MN, NetForceHold, NetForceTarget};
 pub use pi::{Clamp, GainsError, Pi, PiCandidate, PiGains};
 pub use reason::{ExternalFault, Reason, Sensor, SensorFault, SensorFaultKind};
 pub use recip::Reciprocal;

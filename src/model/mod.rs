@@ -95,6 +95,13 @@ pub mod exp_coulomb;
 pub mod horn;
 #[path = "coulomb/littmann.rs"]
 pub mod littmann;
+#[path = "motor/motor.rs"]
+pub mod motor;
+#[path = "motor/motor_regions.rs"]
+pub mod motor_regions;
+#[cfg(test)]
+#[path = "motor/motor_tests.rs"]
+mod motor_tests;
 pub mod quadrature;
 
 pub use any_model::AnyModel;

@@ -47,7 +47,7 @@ pub struct Quadrature {
 
 /// Positive Gauss-Legendre nodes on [-1, 1] (descending, the last is 0 for odd N) and weights,
 /// by Newton's method on the Legendre recurrence (f64, 1e-15).
-fn legendre_half(points: usize, nodes: &mut [f64], weights: &mut [f64]) -> usize {
+pub(crate) fn legendre_half(points: usize, nodes: &mut [f64], weights: &mut [f64]) -> usize {
     let n = points as f64;
     let half = points.div_ceil(2);
     for i in 0..half {

@@ -67,6 +67,7 @@ const DRIVE_MODELS: &[&str] = &[
     "cube_reduction",
     "horn_kinematics",
     "actuator",
+    "motor_force",
 ];
 
 /// Why `key` of `model` is undefined, if it can be.

@@ -6,6 +6,7 @@ pub mod coulomb_dahl;
 pub mod dahl_transient;
 pub mod extremes;
 mod keys;
+pub mod motor;
 
 use std::collections::BTreeMap;
 
@@ -29,6 +30,7 @@ pub fn models() -> Vec<&'static str> {
     let mut all: Vec<&'static str> = coulomb_dahl::MODELS.to_vec();
     all.push("dahl_delta_transient");
     all.extend_from_slice(contact_cube::MODELS);
+    all.extend_from_slice(motor::MODELS);
     all
 }
 
@@ -44,5 +46,6 @@ pub fn eval_fixed_named(
     }
     coulomb_dahl::eval_fixed_coulomb_dahl(model, inputs, variant)
         .or_else(|| contact_cube::eval_fixed_contact_cube(model, inputs, variant))
+        .or_else(|| motor::eval_fixed_motor(model, inputs, variant))
         .unwrap_or_else(|| Err(format!("unknown model `{model}`")))
 }

@@ -210,6 +210,7 @@ fn every_model_has_exactly_its_documented_outputs() {
         ("B_from_A", "B".into()),
         ("exp_coulomb_law", "F_f".into()),
         ("actuator", "I V_limit v_a within_limits x_a".into()),
+        ("motor_force", "F_t kappa phi v_face".into()),
     ];
     assert_eq!(expected.len(), MODELS.len());
     for (model, keys) in expected {

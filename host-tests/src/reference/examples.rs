@@ -32,6 +32,9 @@ pub fn example_inputs(model: &str) -> Result<BTreeMap<String, f64>, RefError> {
         "exp_coulomb_law" => &[("mu_s", 0.42), ("mu_d", 0.32), ("alpha_dc", 0.01), ("Vs", 0.11), ("F_N", 15.0)],
         "actuator" => &[("V", 3.0), ("f", 40e3), ("n", 62.0), ("d33", 730e-12), ("C", 300e-9), ("K_stack", 3.14e8),
                         ("K_bolt", 3.7e7), ("V_max", 15.466), ("I_max", 1.75)],
+        // Seed 001 §3.2: the block held at point -1 (1 in left of the centreline), 120 N.
+        "motor_force" => &[("F_n", 120.0), ("mu", 0.55), ("A", 11.46e-6), ("B", 1.1e-6), ("x", -0.0254), ("L", 0.127),
+                           ("f", 20e3), ("Rq", 6e-6), ("lam", 3.0), ("v_b", 0.0)],
         other => return Err(RefError::UnknownModel(other.to_string())),
     };
     let contact = model.starts_with("contact") || model == "cube_reduction";

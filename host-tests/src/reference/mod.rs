@@ -17,6 +17,7 @@
 //! | [`contact`] | `contact_ep`, `contact_el`, `contact_ep_of_d` |
 //! | [`cube`] | `cube_reduction`, `horn_kinematics`, `B_from_A` |
 //! | [`actuator`] | `actuator` |
+//! | [`motor`] | `motor_force` |
 //!
 //! [`eval_named`] is the uniform, string-keyed entry point; the typed functions of each module
 //! are the same models with named fields.
@@ -34,6 +35,7 @@ pub mod dahl_models;
 mod error;
 mod examples;
 mod keys;
+pub mod motor;
 mod named;
 pub mod numerics;
 

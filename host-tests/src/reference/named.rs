@@ -11,13 +11,14 @@ use super::coulomb::{
     CoulombAvgInput, ExpCoulombInput, SampledSignInput, coulomb_avg_friction,
     coulomb_sampled_avg_sign, exp_coulomb_law, littmann_mu_i,
 };
-use super::cube::{CubeInput, CubeOptions, HornInput, SlipWindow, b_from_a};
+use super::cube::{CubeInput, CubeOptions, HornInput, SlipWindow, UPhase, b_from_a};
 use super::cube::{cube_reduction, horn_kinematics};
 use super::dahl_models::{
     DahlSteadyInput, DahlWindowInput, DeltaTransientInput, dahl_delta_transient, dahl_steady,
     dahl_window,
 };
 use super::keys::{Inputs, Variants, contact_outputs, contact_parameters};
+use super::motor::{MotorInput, motor_force};
 
 /// Every model name accepted by [`eval_named`].
 pub const MODELS: &[&str] = &[
@@ -35,6 +36,7 @@ pub const MODELS: &[&str] = &[
     "B_from_A",
     "exp_coulomb_law",
     "actuator",
+    "motor_force",
 ];
 
 /// Output map of [`eval_named`]: key -> value in SI units (percent for `*_pct`). A quantity
@@ -68,6 +70,7 @@ fn defined<const N: usize>(pairs: [(&'static str, Option<f64>); N]) -> Outputs {
 /// | `B_from_A` | A, D, nu, L | B | - |
 /// | `exp_coulomb_law` | mu_s, mu_d, alpha_dc, Vs, F_N | F_f | - |
 /// | `actuator` | V, f, n, d33, C, K_stack, K_bolt, V_max, I_max | x_a, v_a, I, within_limits, V_limit | - |
+/// | `motor_force` | F_n, mu, A, B, x, L, f, Rq, lam, v_b | F_t, phi, kappa, v_face | u_phase (quadrature default) |
 ///
 /// The contact set is Rq, Rs, An, eta, c, lam, E1, nu1, E2, nu2, nu_soft, Y0. Variant values:
 /// `E_star_rule` = seed000 (default) | seed001; `contact` = ep (default) | el; `window` = vpos
@@ -276,6 +279,37 @@ fn evaluate(
                 ("I", o.current),
                 ("within_limits", if o.within_limits { 1.0 } else { 0.0 }),
                 ("V_limit", o.voltage_limit),
+            ])
+        }
+        "motor_force" => {
+            let phase = w.choose(
+                "u_phase",
+                &[
+                    ("quadrature", UPhase::Quadrature),
+                    ("inphase", UPhase::InPhase),
+                ],
+                "quadrature (default for motor_force), inphase",
+            )?;
+            let o = motor_force(
+                &MotorInput {
+                    friction_coefficient: i.get("mu")?,
+                    normal_force: i.get("F_n")?,
+                    longitudinal_amplitude: i.get("A")?,
+                    vertical_amplitude: i.get("B")?,
+                    position: i.get("x")?,
+                    horn_length: i.get("L")?,
+                    frequency: i.get("f")?,
+                    roughness_rq: i.get("Rq")?,
+                    distribution_lambda: i.get("lam")?,
+                    block_velocity: i.get("v_b")?,
+                },
+                phase,
+            )?;
+            Outputs::from([
+                ("F_t", o.net_force),
+                ("phi", o.drive_ratio),
+                ("kappa", o.decay),
+                ("v_face", o.face_speed),
             ])
         }
         _ => return Err(RefError::UnknownModel(name.to_string())),

@@ -22,6 +22,7 @@
 //! breakpoints and fault onsets land on the control grid exactly, however long the run.
 
 pub mod contact;
+pub mod motor_contact;
 pub mod noise;
 pub mod profile;
 pub mod sensors;
