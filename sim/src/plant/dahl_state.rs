@@ -111,6 +111,8 @@ struct Record {
     start_phase: u32,
     drive: Drive,
     span: u64,
+    /// The load f was referred to over the substep, N.
+    load_n: f32,
 }
 
 /// The geometry of one substep's drive.
@@ -227,8 +229,9 @@ impl DahlState {
     /// Advances the contact by `dt_s` with the load `normal_n` (N), the sliding velocity
     /// `velocity_m_per_s` (m/s, signed), the vibration amplitude `amplitude` (fraction of full
     /// scale, clamped to [0, 1], NaN as 0) and the vibration frequency `frequency_hz` held.
-    /// Returns the time average of f over the last vibration period ending with the step (over
-    /// the step itself without vibration; f at the end when the step is empty).
+    /// Returns the time average of the force over the last vibration period ending with the
+    /// step, in units of the present mu W (over the step itself without vibration; f at the end
+    /// when the step is empty).
     /// Non-finite or non-positive loads unload the contact (f = 0); a non-finite velocity
     /// counts as no sliding; a non-finite or non-positive frequency as no vibration.
     pub fn advance(
@@ -248,6 +251,7 @@ impl DahlState {
         if !(normal_n > 0.0 && normal_n.is_finite()) {
             self.force_ratio = Q2_30::ZERO;
             self.load_n = 0.0;
+            self.history = [None; HISTORY];
             self.phase = self.phase.wrapping_add(span as u32);
             return 0.0;
         }
@@ -304,6 +308,7 @@ impl DahlState {
             start_phase: self.phase,
             drive,
             span,
+            load_n: self.load_n,
         });
         let (whole, tail) = self.walk(&drive, span, span.saturating_sub(TURN));
         self.period_mean(span, whole, tail)
@@ -460,7 +465,8 @@ impl DahlState {
                 ..self.clone()
             };
             let (_, part) = shadow.walk(&record.drive, record.span, record.span - take);
-            integral += part;
+            // The force is what is averaged: f of an earlier load counts as mu W_then f.
+            integral += part * (record.load_n / self.load_n);
             covered += take;
         }
         integral / covered as f32
