@@ -311,7 +311,10 @@ impl PaperCase {
 
 // ---- Shared inputs -------------------------------------------------------------------------
 
-/// Seed 000 Table 2, aluminium (body 1, the softer) on stainless steel.
+/// Seed 000 Table 2, aluminium (body 1, the softer) on stainless steel (SI units). The f64
+/// reference keeps this copy of its own, written from the paper, so that it stays independent of
+/// the firmware's (`sonolube::model::contact::ContactParams::SEED_000_TABLE_2_AL_ON_SS`): a typo
+/// in one shows as a disagreement instead of passing through both.
 #[rustfmt::skip]
 pub const AL_SS: &[(&str, f64)] = &[
     ("Rq", 6e-6), ("Rs", 1.7e-6), ("An", 1e-4), ("eta", 47e9), ("c", 17.0), ("lam", 3.0),

@@ -345,20 +345,7 @@ fn quadrature_error_falls_with_n() {
 #[test]
 fn friction_model_interface_matches_the_reference_and_inverts() {
     let scene = CubeParams {
-        contact: sonolube::model::contact::ContactParams {
-            roughness_rq: 6e-6,
-            summit_radius: 1.7e-6,
-            nominal_area: 1e-4,
-            asperity_density: 47e9,
-            distribution_c: 17.0,
-            distribution_lambda: 3.0,
-            young_1: 73e9,
-            poisson_1: 0.33,
-            young_2: 200e9,
-            poisson_2: 0.29,
-            poisson_soft: 0.33,
-            yield_strength: 410e6,
-        },
+        contact: sonolube::model::contact::ContactParams::SEED_000_TABLE_2_AL_ON_SS,
         friction_coefficient: 0.54,
         longitudinal_amplitude: 40e-6,
         vertical_amplitude: 4e-6,

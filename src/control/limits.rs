@@ -13,6 +13,7 @@
 //! configuration is built from the scene's numbers.
 
 use crate::fx::Q1_31;
+use crate::model::actuator::ActuatorParams;
 
 /// Electrical ratings of the actuator and its drive, SI units (configuration only).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -30,14 +31,15 @@ pub struct ActuatorRatings {
 }
 
 impl ActuatorRatings {
-    /// The PMN-PT stack of seed 003 Table 1 at 40 kHz, with full scale at the voltage rating:
-    /// `V_max = 0.7 um / (730 pm/V * 62) = 15.466 V`, `I_max = 1.75 A`, `C = 300 nF`.
+    /// The PMN-PT stack of seed 003 Table 1 at 40 kHz, with full scale at the voltage rating;
+    /// the ratings come from their one definition, [`ActuatorParams::SEED_003_TABLE_1`]
+    /// (V_max = 15.466 V, I_max = 1.75 A, C = 300 nF).
     pub const SEED_003_40_KHZ: Self = Self {
-        max_voltage_v: 0.7e-6 / (730e-12 * 62.0),
-        max_current_a: 1.75,
-        capacitance_f: 300e-9,
+        max_voltage_v: ActuatorParams::SEED_003_TABLE_1.max_voltage_v,
+        max_current_a: ActuatorParams::SEED_003_TABLE_1.max_current_a,
+        capacitance_f: ActuatorParams::SEED_003_TABLE_1.capacitance_f,
         drive_frequency_hz: 40_000.0,
-        full_scale_voltage_v: 0.7e-6 / (730e-12 * 62.0),
+        full_scale_voltage_v: ActuatorParams::SEED_003_TABLE_1.max_voltage_v,
     };
 }
 

@@ -15,6 +15,7 @@ use super::amplitude::Amplitude;
 use super::error::DriveError;
 use super::frequency::Frequency;
 use crate::fx::Q2_30;
+use crate::model::actuator::ActuatorParams;
 
 /// Electrical ratings of the piezo stack.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -28,12 +29,12 @@ pub struct StackRatings {
 }
 
 impl StackRatings {
-    /// The PMN-PT stack of seed 003 Table 1: `V_max = dL / (d33 n) = 0.7 um / (730 pm/V * 62)
-    /// = 15.466 V`, `I_max = 1.75 A` (2 pi f C V_max at 60 kHz), `C = 300 nF`.
+    /// The ratings of the PMN-PT stack of seed 003 Table 1, taken from its one definition,
+    /// [`ActuatorParams::SEED_003_TABLE_1`] (V_max = 15.466 V, I_max = 1.75 A, C = 300 nF).
     pub const SEED_003: Self = Self {
-        max_voltage_v: 0.7e-6 / (730e-12 * 62.0),
-        max_current_a: 1.75,
-        capacitance_f: 300e-9,
+        max_voltage_v: ActuatorParams::SEED_003_TABLE_1.max_voltage_v,
+        max_current_a: ActuatorParams::SEED_003_TABLE_1.max_current_a,
+        capacitance_f: ActuatorParams::SEED_003_TABLE_1.capacitance_f,
     };
 }
 

@@ -55,13 +55,14 @@
 //! | `checked_div(_to)`            |                           | 0.5 ulp              | ~200   |
 //!
 //! (asin: |z| <= 1/2 / |z| > 1/2, which needs a square root; sin / sin_cos. `exp_neg`: below
-//! the Dahl update's 44 instructions, which call it once.)
+//! the Dahl update's count (row "Dahl update" of `docs/speed.md`), as the update calls it once.)
 //!
 //! # For the model code
 //!
 //! - Littmann law (physics-notes §1): `zeta: Q2_30 = v_s.checked_div_to(v_a)?` (precompute
 //!   `1/v_a` when it changes to avoid the division), handle |zeta| >= 1 first, then the
-//!   (2/pi) asin with the gain folded in (`littmann::mu_i`, 45 instructions).
+//!   (2/pi) asin with the gain folded in (`littmann::mu_i`; its instruction count is the row
+//!   "Littmann closed form" of `docs/speed.md`, which `scripts/speed-table` measures).
 //! - Dahl update (§2): carry `f` in Q2.30 (exact +-1), `decay = kappa_dx.exp_neg()?` with
 //!   `kappa |dx|` in the finest format that holds it (Q2.30 below 2, Q8.24 below 128), then
 //!   `f = s.lerp(f, decay)?`, which stays in [-1, 1] by construction.

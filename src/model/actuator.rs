@@ -41,8 +41,15 @@ pub struct ActuatorParams {
 }
 
 impl ActuatorParams {
-    /// The stack of seed 003 Table 1.
-    pub const SEED_003: Self = Self {
+    /// The PMN-PT stack of seed 003 (Bharadwaj & Dapino) Table 1, SI units: n = 62 discs,
+    /// d33 = 730 pm/V, C = 300 nF, K_stack = 3.14e8 N/m, K_bolt = 3.7e7 N/m, and the ratings
+    /// `V_max = dL / (d33 n) = 0.7 um / (730 pm/V * 62) = 15.466 V` and `I_max = 1.75 A`
+    /// (2 pi f C V_max at 60 kHz). The one definition of these numbers in the firmware core:
+    /// `crate::drive::StackRatings::SEED_003` and
+    /// `crate::control::ActuatorRatings::SEED_003_40_KHZ` take their ratings from it. The f64
+    /// reference in host-tests keeps its own copy (`reference::examples`, the `actuator`
+    /// inputs) so that the two are written independently.
+    pub const SEED_003_TABLE_1: Self = Self {
         discs: 62.0,
         d33_m_per_v: 730e-12,
         capacitance_f: 300e-9,
@@ -205,7 +212,7 @@ mod tests {
     use core::f64::consts::TAU;
 
     fn seed003() -> ActuatorConstants {
-        ActuatorConstants::new(&ActuatorParams::SEED_003).unwrap()
+        ActuatorConstants::new(&ActuatorParams::SEED_003_TABLE_1).unwrap()
     }
 
     fn q16(x: f64) -> Q16_16 {
@@ -231,7 +238,7 @@ mod tests {
         );
         let free = ActuatorConstants::new(&ActuatorParams {
             bolt_stiffness: 0.0,
-            ..ActuatorParams::SEED_003
+            ..ActuatorParams::SEED_003_TABLE_1
         })
         .unwrap();
         assert!((free.stroke_um(q16(v_max)).unwrap().to_f64() - 0.7).abs() < 1e-5);
@@ -266,7 +273,7 @@ mod tests {
             Ok(Q8_24::ZERO)
         );
         let bad = |p: ActuatorParams| ActuatorConstants::new(&p).is_err();
-        let s = ActuatorParams::SEED_003;
+        let s = ActuatorParams::SEED_003_TABLE_1;
         assert!(
             bad(ActuatorParams { discs: 61.5, ..s }) && bad(ActuatorParams { discs: 0.0, ..s })
         );

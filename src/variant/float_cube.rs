@@ -199,27 +199,9 @@ mod tests {
     use super::*;
     use crate::variant::real::{Libm, Micromath};
 
-    /// Seed 000 Table 2, Al on SS.
-    fn al_ss() -> ContactParams {
-        ContactParams {
-            roughness_rq: 6e-6,
-            summit_radius: 1.7e-6,
-            nominal_area: 1e-4,
-            asperity_density: 47e9,
-            distribution_c: 17.0,
-            distribution_lambda: 3.0,
-            young_1: 73e9,
-            poisson_1: 0.33,
-            young_2: 200e9,
-            poisson_2: 0.29,
-            poisson_soft: 0.33,
-            yield_strength: 410e6,
-        }
-    }
-
     fn params(kind: ContactKind, points: usize, position: f64) -> FloatCubeParams {
         FloatCubeParams {
-            contact: al_ss(),
+            contact: ContactParams::SEED_000_TABLE_2_AL_ON_SS,
             contact_kind: kind,
             friction_coefficient: 0.54,
             longitudinal_amplitude: 11.46e-6,

@@ -7,12 +7,9 @@ use std::collections::BTreeMap;
 
 use super::RefError;
 
-/// Seed 000 Table 2, aluminium on stainless steel (SI units).
-#[rustfmt::skip]
-const CONTACT_AL_SS: &[(&str, f64)] = &[
-    ("Rq", 6e-6), ("Rs", 1.7e-6), ("An", 1e-4), ("eta", 47e9), ("c", 17.0), ("lam", 3.0),
-    ("E1", 73e9), ("nu1", 0.33), ("E2", 200e9), ("nu2", 0.29), ("nu_soft", 0.33), ("Y0", 410e6),
-];
+/// Seed 000 Table 2, aluminium on stainless steel (SI units): the f64 reference's own copy,
+/// [`crate::papers::AL_SS`].
+const CONTACT_AL_SS: &[(&str, f64)] = crate::papers::AL_SS;
 
 /// A valid input map for `model` (SI units), or [`RefError::UnknownModel`].
 #[rustfmt::skip]
@@ -30,6 +27,8 @@ pub fn example_inputs(model: &str) -> Result<BTreeMap<String, f64>, RefError> {
         "horn_kinematics" => &[("x", 0.01), ("t", 1e-5), ("A", 11.46e-6), ("B", 1.1e-6), ("f", 20e3), ("L", 0.127)],
         "B_from_A" => &[("A", 11.46e-6), ("D", 25.4e-3), ("nu", 0.33), ("L", 0.127)],
         "exp_coulomb_law" => &[("mu_s", 0.42), ("mu_d", 0.32), ("alpha_dc", 0.01), ("Vs", 0.11), ("F_N", 15.0)],
+        // Seed 003 Table 1: the f64 reference's own copy, independent of the firmware's
+        // `sonolube::model::actuator::ActuatorParams::SEED_003_TABLE_1`.
         "actuator" => &[("V", 3.0), ("f", 40e3), ("n", 62.0), ("d33", 730e-12), ("C", 300e-9), ("K_stack", 3.14e8),
                         ("K_bolt", 3.7e7), ("V_max", 15.466), ("I_max", 1.75)],
         // Seed 001 §3.2: the block held at point -1 (1 in left of the centreline), 120 N.

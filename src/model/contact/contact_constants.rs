@@ -32,9 +32,8 @@ pub enum ContactKind {
     Elastic,
 }
 
-/// Material and surface parameters in SI units (seed 000 Table 2: R_q = 6 um, R_s = 1.7 um,
-/// A_n = 1e-4 m^2, eta = 47e9 /m^2, c = 17, lambda = 3, Al 73 GPa / 0.33, SS 200 GPa / 0.29,
-/// Y0 = 410 MPa).
+/// Material and surface parameters in SI units (seed 000 Table 2 gives them for aluminium on
+/// stainless steel: [`ContactParams::SEED_000_TABLE_2_AL_ON_SS`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactParams {
     /// Standard deviation of asperity heights R_q in m (> 0).
@@ -62,6 +61,31 @@ pub struct ContactParams {
     pub poisson_soft: f64,
     /// Failure strength Y0 of the softer material in Pa (> 0; elastic-plastic only).
     pub yield_strength: f64,
+}
+
+impl ContactParams {
+    /// Seed 000 (Dong & Dapino, elastic-plastic cube model) Table 2: aluminium (body 1, the
+    /// softer) on stainless steel (body 2), SI units. The one definition of these numbers in
+    /// the firmware core; the f64 reference in host-tests keeps its own copy
+    /// (`sonolube_host::papers::AL_SS`) so that the two are written independently.
+    pub const SEED_000_TABLE_2_AL_ON_SS: Self = Self {
+        // R_q = 6 um, R_s = 1.7 um, A_n = 1e-4 m^2, eta = 47e9 /m^2.
+        roughness_rq: 6e-6,
+        summit_radius: 1.7e-6,
+        nominal_area: 1e-4,
+        asperity_density: 47e9,
+        // Exponential height distribution (eq 2): c = 17, lambda = 3.
+        distribution_c: 17.0,
+        distribution_lambda: 3.0,
+        // Al: E = 73 GPa, nu = 0.33; SS: E = 200 GPa, nu = 0.29.
+        young_1: 73e9,
+        poisson_1: 0.33,
+        young_2: 200e9,
+        poisson_2: 0.29,
+        // Al is the softer material: its nu, and Y0 = 410 MPa.
+        poisson_soft: 0.33,
+        yield_strength: 410e6,
+    };
 }
 
 /// The load-independent constants of a contact (f64, SI units): every force is
@@ -278,20 +302,7 @@ mod tests {
 
     #[test]
     fn validation_names_the_input() {
-        let p = ContactParams {
-            roughness_rq: 6e-6,
-            summit_radius: 1.7e-6,
-            nominal_area: 1e-4,
-            asperity_density: 47e9,
-            distribution_c: 17.0,
-            distribution_lambda: 3.0,
-            young_1: 73e9,
-            poisson_1: 0.33,
-            young_2: 200e9,
-            poisson_2: 0.29,
-            poisson_soft: 0.33,
-            yield_strength: 410e6,
-        };
+        let p = ContactParams::SEED_000_TABLE_2_AL_ON_SS;
         let ep = (EStarRule::Seed000, ContactKind::ElasticPlastic);
         assert!(scene_contact(&p, ep.0, ep.1).is_ok());
         let bad = ContactParams {

@@ -1,24 +1,13 @@
 //! Unit tests of the fixed-point contact model (physics-notes §3 numbers, guards, inverses).
 use super::*;
 
-/// Seed 000 Table 2, Al on SS.
-pub(crate) const AL_SS: ContactParams = ContactParams {
-    roughness_rq: 6e-6,
-    summit_radius: 1.7e-6,
-    nominal_area: 1e-4,
-    asperity_density: 47e9,
-    distribution_c: 17.0,
-    distribution_lambda: 3.0,
-    young_1: 73e9,
-    poisson_1: 0.33,
-    young_2: 200e9,
-    poisson_2: 0.29,
-    poisson_soft: 0.33,
-    yield_strength: 410e6,
-};
-
 fn constants(kind: ContactKind) -> ContactConstants {
-    ContactConstants::new(&AL_SS, EStarRule::Seed000, kind).unwrap()
+    ContactConstants::new(
+        &ContactParams::SEED_000_TABLE_2_AL_ON_SS,
+        EStarRule::Seed000,
+        kind,
+    )
+    .unwrap()
 }
 
 fn separation_um(c: &ContactConstants, load: f64) -> f64 {

@@ -4,26 +4,10 @@
 use super::*;
 use crate::model::contact::ln_load_from_si;
 
-/// Seed 000 Table 2, Al on SS.
-pub(crate) const AL_SS: ContactParams = ContactParams {
-    roughness_rq: 6e-6,
-    summit_radius: 1.7e-6,
-    nominal_area: 1e-4,
-    asperity_density: 47e9,
-    distribution_c: 17.0,
-    distribution_lambda: 3.0,
-    young_1: 73e9,
-    poisson_1: 0.33,
-    young_2: 200e9,
-    poisson_2: 0.29,
-    poisson_soft: 0.33,
-    yield_strength: 410e6,
-};
-
 /// Seed 000 Table 1 test 1 at the node (mu = 0.54, A = 11.46 um, B = 1.1 um, 20 kHz).
 pub(crate) fn test_1(position: f64) -> CubeParams {
     CubeParams {
-        contact: AL_SS,
+        contact: ContactParams::SEED_000_TABLE_2_AL_ON_SS,
         friction_coefficient: 0.54,
         longitudinal_amplitude: 11.46e-6,
         vertical_amplitude: 1.1e-6,
