@@ -76,12 +76,26 @@ pub struct Settings {
     pub kp: f64,
     /// Integral gain of the correction PI in steady state, 1/s.
     pub ki_per_s: f64,
-    /// Time constant of the fading from the fast to the steady gains, s.
-    pub boost_time_constant_s: f64,
+    /// How long the fast gains are held after the loop closes or the target changes, s
+    /// (then they fade to the steady ones by the running-mean law, `schedule.rs`).
+    pub boost_hold_s: f64,
     /// Bound of the PI's integral, ratio units.
     pub integral_limit: f64,
     /// The actuator's ratings, for the amplitude ceiling.
     pub actuator: ActuatorRatings,
+    /// RMS noise of one normal-force sample, N: measured by the cell's `tare`
+    /// (`sense::SensorChannel::noise`), the datasheet's until then. Only the tuning rule
+    /// ([`super::tuned`]) reads it.
+    pub normal_noise_n: f64,
+    /// RMS noise of one tangential-force sample, N (as `normal_noise_n`).
+    pub tangential_noise_n: f64,
+    /// The model's declared relative mismatch: the plant's friction reduction may differ from
+    /// the model's by this fraction (0.2: the acceptance's +-20 % in mu and k_t). Only the
+    /// tuning rule reads it.
+    pub model_mismatch: f64,
+    /// The load the noise is referred to, N: the lightest load the rig runs at (where the
+    /// cells' noise is largest against the forces). Only the tuning rule reads it.
+    pub design_load_n: f64,
 }
 
 impl Settings {
@@ -119,9 +133,13 @@ impl Settings {
         ki_fast_per_s: 4_000.0,
         kp: 0.0,
         ki_per_s: 150.0,
-        boost_time_constant_s: 3e-3,
+        boost_hold_s: 3e-3,
         integral_limit: 0.5,
         actuator: ActuatorRatings::SEED_003_40_KHZ,
+        normal_noise_n: 0.05,
+        tangential_noise_n: 0.01,
+        model_mismatch: 0.2,
+        design_load_n: 4.0,
     };
 }
 
@@ -187,6 +205,21 @@ pub struct Config {
     pub(super) limit: AmplitudeLimit,
     /// The ratings `limit` was computed from, kept for [`Config::at_drive_frequency`].
     pub(super) actuator: ActuatorRatings,
+}
+
+/// The PI's gain schedule of `settings`: the fast set held for `boost_hold_s`, fading to the
+/// steady set. Errors: `Gains` for unusable gains or hold, `OutOfRange` for the period.
+pub fn gain_schedule(settings: &Settings) -> Result<GainSchedule, ConfigError> {
+    let s = settings;
+    let period = positive(s.period_s, "period_s")?;
+    GainSchedule::new(
+        PiGains::new(s.kp_fast, s.ki_fast_per_s, period, s.integral_limit)
+            .map_err(ConfigError::Gains)?,
+        PiGains::new(s.kp, s.ki_per_s, period, s.integral_limit).map_err(ConfigError::Gains)?,
+        s.boost_hold_s,
+        period,
+    )
+    .map_err(ConfigError::Gains)
 }
 
 /// A positive finite value, or the error naming `setting`.
@@ -301,15 +334,7 @@ impl Config {
                 up_step: step(s.ramp_up_full_scale_s, "ramp_up_full_scale_s")?,
                 down_step: step(s.ramp_down_full_scale_s, "ramp_down_full_scale_s")?,
             },
-            gains: GainSchedule::new(
-                PiGains::new(s.kp_fast, s.ki_fast_per_s, period, s.integral_limit)
-                    .map_err(ConfigError::Gains)?,
-                PiGains::new(s.kp, s.ki_per_s, period, s.integral_limit)
-                    .map_err(ConfigError::Gains)?,
-                s.boost_time_constant_s,
-                period,
-            )
-            .map_err(ConfigError::Gains)?,
+            gains: gain_schedule(s)?,
             limit: AmplitudeLimit::new(&s.actuator).map_err(ConfigError::Limits)?,
             actuator: s.actuator,
         })

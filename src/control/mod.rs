@@ -139,7 +139,7 @@ mod property_tests;
 #[cfg(test)]
 mod testkit;
 
-pub use config::{Config, ConfigError, SensorRanges, Settings};
+pub use config::{Config, ConfigError, SensorRanges, Settings, gain_schedule};
 pub use controller::{Controller, ControllerState};
 pub use error::ControlError;
 pub use estimate::{
@@ -158,6 +158,8 @@ pub use sliding::{SlidingConfig, SlidingDetector};
 pub use supervisor::{Contact, RampConfig, Supervisor};
 pub use target::{ForceQ, PreparedTarget};
 pub use tuning::{
-    FAST_GAINS, FORCE_FILTER_HZ, NATURAL_LEARN_S, NATURAL_PRIOR_WEIGHT, SLIDING_DEBOUNCE_S,
-    STEADY_GAINS, VELOCITY_FILTER_HZ, controller_settings,
+    DECLARED_MODEL_MISMATCH, FORCE_FILTER_HZ, HOLD_LAG_MULTIPLE, NATURAL_LEARN_S,
+    NATURAL_PRIOR_WEIGHT, SLIDING_DEBOUNCE_S, STEADY_GAINS, VELOCITY_FILTER_HZ,
+    controller_settings, noise_limited_ki_per_s, observation_lag_s, ratio_noise,
+    sampled_ki_cap_per_s, tuned,
 };

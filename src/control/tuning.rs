@@ -6,7 +6,7 @@
 //! runs the tuning the scene runs were judged with. The departures were found on the scene runs
 //! (`sonolube scene --all`, 12 noise seeds), each with a physical reason.
 
-use super::config::Settings;
+use super::config::{ConfigError, Settings};
 use super::limits::ActuatorRatings;
 use crate::scene::{LoadCell, Scene};
 
@@ -77,25 +77,98 @@ pub const NATURAL_LEARN_S: f64 = 3e-3;
 /// reference scene's steady RMS error goes from 0.68 % to 0.69 %.
 pub const STEADY_GAINS: (f64, f64) = (0.1, 300.0);
 
-/// Fast PI gains (the set the boost starts from at a start or a target change):
-/// proportional (ratio per ratio) and integral (1/s).
-///
-/// The baseline's kp 0.3, ki 4000 /s (`kiT` 0.4, poles 0.72 and -0.42) left the mismatch
-/// grid's stiffest, highest-friction corner (plant mu x1.3 and k_t x2 of the controller's:
-/// the plant reduces the friction more at a given amplitude than the model says) to the
-/// feedforward's own overshoot for too long: 5.04-5.28 % of the step (limit 5 %) at 6 of 81
-/// points, with the drive pinned or following the resonance. The overshoot shrinks as the
-/// integral learns that model error sooner (ki 3000, 4000, 5000, 6000 /s: worst 5.6, 5.3,
-/// 5.0, 4.8 %); at ki 6000 /s (`kiT` 0.6: poles 0.6 and -0.5, a 0.2 ms time constant, still
-/// well inside the unit circle) every grid point passes on the scene's seed and the seed
-/// sweep of every scene is unchanged in its verdicts (1,300 of 1,300). The steady gains
-/// take over within the boost's 3 ms, so the steady RMS error does not see the faster set.
-pub const FAST_GAINS: (f64, f64) = (0.3, 6_000.0);
+/// The model's mismatch the tuning assumes when the user declares none: the plant's friction
+/// reduction may differ from the model's by +-20 % (the acceptance scene's mu x1.2 and k_t
+/// x0.8, and the mismatch grid's range).
+pub const DECLARED_MODEL_MISMATCH: f64 = 0.2;
+
+/// How long the fast gains are held, in observation lags ([`observation_lag_s`]): the observed
+/// model error rises with the lag chain's step response, so the hold lasts until it is within
+/// about e^-3 (5 %) of its new value; after that it is constant and the gain falls by the
+/// running-mean law (`schedule.rs`).
+pub const HOLD_LAG_MULTIPLE: f64 = 3.0;
+
+/// The lag chain the PI sees the model error through, s: the drive's envelope with the lead
+/// (`response_time_constant_s`), the tangential cell's lag and the force filter. The
+/// prediction passes the same stages, so the chain delays the model error, not the loop.
+pub fn observation_lag_s(s: &Settings) -> f64 {
+    s.response_time_constant_s
+        + s.sensor_lag_s
+        + 1.0 / (core::f64::consts::TAU * s.tangential_bandwidth_hz)
+}
+
+/// RMS noise of one sample of the measured friction ratio `F_t / (mu0 F_n)` at the design
+/// load, ratio units: the tangential cell's noise against the natural friction force `mu0 W`
+/// and the normal cell's against `W`, independent, so their squares add.
+pub fn ratio_noise(s: &Settings) -> f64 {
+    let load = s.design_load_n;
+    let friction = s.natural_prior * load;
+    libm::sqrt(
+        libm::pow(s.tangential_noise_n / friction, 2.0) + libm::pow(s.normal_noise_n / load, 2.0),
+    )
+}
+
+/// The fast integral gain the noise allows, 1/s: the steady gain of a Kalman-Bucy filter of
+/// the observed model error while the drive's transient moves it, `K = sqrt(q / r)`. The
+/// error is of size `m` (the declared mismatch, ratio units over the model's range) and moves
+/// over one observation lag `tau_L`: process noise density `q = m^2 / tau_L`. One sample of
+/// the ratio has noise `sigma_r` ([`ratio_noise`]) each period `T`: measurement noise density
+/// `r = sigma_r^2 T`. So `K = m / (sigma_r sqrt(tau_L T))`: the gain falls as the noise grows
+/// (the loop leans on the model) and rises with the mismatch (it leans on the cells).
+pub fn noise_limited_ki_per_s(s: &Settings) -> f64 {
+    let sigma = ratio_noise(s);
+    s.model_mismatch / (sigma * libm::sqrt(observation_lag_s(s) * s.period_s))
+}
+
+/// The fast integral gain the sampled loop allows, 1/s. For a static model error whose size
+/// grows with the correction by up to `g = 1 / (1 - m)` (a plant that reduces the friction `m`
+/// more than the model says), the correction's dominant pole is `1 - g (kp + ki T)` ("Tuning by
+/// pole placement" in [`crate::control`]); it stays at or above zero, so that the correction
+/// never alternates, for `ki T <= 1 / g - kp = 1 - m - kp`.
+pub fn sampled_ki_cap_per_s(s: &Settings) -> f64 {
+    libm::fmax(1.0 - s.model_mismatch - s.kp_fast, 0.0) / s.period_s
+}
+
+/// `settings` with the fast integral gain and the hold computed by the design rule from the
+/// rig's parameters in it (the control period, the lag chain [`observation_lag_s`], the
+/// cells' noise [`ratio_noise`] and the declared mismatch): `ki_fast` the smaller of
+/// [`noise_limited_ki_per_s`] and [`sampled_ki_cap_per_s`], the hold [`HOLD_LAG_MULTIPLE`]
+/// observation lags. The steady gains and the fast `kp` are kept. The station calls it again
+/// with the noise its `tare` measured. Errors: a mismatch outside [0, 1), a negative or
+/// non-finite noise or a non-positive design load or prior (`OutOfRange` naming the setting).
+pub fn tuned(settings: &Settings) -> Result<Settings, ConfigError> {
+    let s = settings;
+    let bad = |setting| Err(ConfigError::OutOfRange { setting });
+    if !(s.model_mismatch >= 0.0 && s.model_mismatch < 1.0) {
+        return bad("model_mismatch");
+    }
+    for (value, setting) in [
+        (s.normal_noise_n, "normal_noise_n"),
+        (s.tangential_noise_n, "tangential_noise_n"),
+    ] {
+        if !(value >= 0.0 && value.is_finite()) {
+            return bad(setting);
+        }
+    }
+    if !(s.design_load_n > 0.0 && s.design_load_n.is_finite()) {
+        return bad("design_load_n");
+    }
+    if !(s.natural_prior > 0.0 && s.period_s > 0.0 && s.tangential_bandwidth_hz > 0.0) {
+        return bad("natural_prior");
+    }
+    // A noise-free cell allows any gain: the sampled cap binds (min of x and +inf is x).
+    let ki_fast = libm::fmin(sampled_ki_cap_per_s(s), noise_limited_ki_per_s(s));
+    Ok(Settings {
+        ki_fast_per_s: ki_fast,
+        boost_hold_s: HOLD_LAG_MULTIPLE * observation_lag_s(s),
+        ..*s
+    })
+}
 
 /// The controller's settings for `scene`: [`Settings::REFERENCE`] with the tuning's
 /// departures ([`FORCE_FILTER_HZ`] for both force filters, [`VELOCITY_FILTER_HZ`],
 /// [`NATURAL_PRIOR_WEIGHT`], [`SLIDING_DEBOUNCE_S`], [`NATURAL_LEARN_S`], [`STEADY_GAINS`],
-/// [`FAST_GAINS`]) and
+/// and the fast integral gain and hold of the design rule [`tuned`]) and
 /// what the scene fixes: the control period, the actuator ratings at the drive frequency, the
 /// controller's natural coefficient as the prior of mu0, plausible ranges of the readings
 /// (1.1 x each cell's full scale, twice the fastest sliding speed but at least 5 m/s), the
@@ -134,8 +207,8 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
     let cell_lag_s = 1.0 / (core::f64::consts::TAU * scene.tangential_cell.bandwidth_hz);
     let envelope = scene.transducer.envelope_time_constant_s();
     let (kp, ki_per_s) = STEADY_GAINS;
-    let (kp_fast, ki_fast_per_s) = FAST_GAINS;
-    Settings {
+    let declared_noise = |cell: &LoadCell| cell.noise_rms_pct_fs / 100.0 * cell.full_scale_n;
+    let settings = Settings {
         period_s: scene.control_period_s(),
         normal_bandwidth_hz: FORCE_FILTER_HZ,
         tangential_bandwidth_hz: FORCE_FILTER_HZ,
@@ -164,8 +237,6 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
         response_time_constant_s: libm::fmin(reference.response_time_constant_s, envelope),
         kp,
         ki_per_s,
-        kp_fast,
-        ki_fast_per_s,
         actuator: ActuatorRatings {
             max_voltage_v: scene.actuator.max_voltage_v,
             max_current_a: scene.actuator.max_current_a,
@@ -173,14 +244,57 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
             drive_frequency_hz: scene.transducer.drive_hz,
             full_scale_voltage_v: scene.actuator.full_scale_voltage_v,
         },
+        // The datasheet's noise until a tare measures it (`Station::tune_to_cells`).
+        normal_noise_n: declared_noise(&scene.normal_cell),
+        tangential_noise_n: declared_noise(&scene.tangential_cell),
+        model_mismatch: DECLARED_MODEL_MISMATCH,
+        design_load_n: scene.contents.load_min_n,
         ..reference
-    }
+    };
+    // The scene schema bounds the noise to [0, 10] % FS and the loads to positive values,
+    // and the mismatch is the constant above: the rule accepts them.
+    tuned(&settings).unwrap_or(settings)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::scene::find;
+
+    #[test]
+    fn the_fast_gain_follows_the_noise_and_the_mismatch() {
+        let base = controller_settings(find("reference").expect("built in"));
+        let at = |noise_factor: f64, mismatch: f64| {
+            let s = Settings {
+                normal_noise_n: base.normal_noise_n * noise_factor,
+                tangential_noise_n: base.tangential_noise_n * noise_factor,
+                model_mismatch: mismatch,
+                ..base
+            };
+            tuned(&s).expect("valid").ki_fast_per_s
+        };
+        // The reference's noise leaves the sampled cap binding; 20 and 40 times the noise
+        // bring the Kalman gain below it, halving with each doubling of the noise.
+        assert_eq!(at(1.0, 0.2), at(2.0, 0.2));
+        let (k20, k40) = (at(20.0, 0.2), at(40.0, 0.2));
+        assert!(k20 < at(1.0, 0.2), "{k20}");
+        assert!((k20 / k40 - 2.0).abs() < 1e-9, "{k20} {k40}");
+        // A larger declared mismatch leans on the cells: a higher noise-limited gain.
+        assert!(at(40.0, 0.3) > k40);
+        // And a smaller cap: the mismatch's growth with the correction limits kiT.
+        assert!(at(1.0, 0.4) < at(1.0, 0.2));
+        // Refused: a mismatch of 100 %, a negative noise.
+        let bad = Settings {
+            model_mismatch: 1.0,
+            ..base
+        };
+        assert!(tuned(&bad).is_err());
+        let bad = Settings {
+            tangential_noise_n: -1.0,
+            ..base
+        };
+        assert!(tuned(&bad).is_err());
+    }
 
     #[test]
     fn the_reference_scene_fixes_its_numbers_and_keeps_the_tuning() {
@@ -210,11 +324,19 @@ mod tests {
         assert_eq!((s.kp, s.ki_per_s), STEADY_GAINS);
         assert_eq!(s.natural_prior_weight, NATURAL_PRIOR_WEIGHT);
         assert_eq!(s.sliding_debounce_s, SLIDING_DEBOUNCE_S);
-        assert_eq!(
-            (s.kp_fast, s.ki_fast_per_s, s.boost_time_constant_s),
-            (0.3, 6_000.0, 3e-3)
+        // The rule: kiT capped at 1 - 0.2 - 0.3 = 0.5 (the noise allows 38 000 /s), held for
+        // three lags of 0.25 ms + 79.6 us + 0.637 ms.
+        assert_eq!(s.kp_fast, 0.3);
+        assert!(
+            (s.ki_fast_per_s - 5_000.0).abs() < 1e-6,
+            "{}",
+            s.ki_fast_per_s
         );
-        assert_eq!((s.kp_fast, s.ki_fast_per_s), FAST_GAINS);
+        assert!(
+            (s.boost_hold_s - 3.0 * 0.966_2e-3).abs() < 1e-6,
+            "{}",
+            s.boost_hold_s
+        );
         assert!((s.tangential_force_range_n - 2.2).abs() < 1e-12);
         assert_eq!(s.velocity_range_m_s, 5.0);
         assert!(crate::control::Config::new(&s).is_ok());
