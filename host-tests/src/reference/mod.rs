@@ -31,6 +31,7 @@ mod cross_checks;
 pub mod cube;
 mod dahl;
 pub mod dahl_models;
+pub mod dahl_ode;
 mod error;
 mod examples;
 mod keys;

@@ -5,10 +5,18 @@
 //! coefficient (mu, or seed 002 eq 10's mu(v) for the exponential law), and the friction force
 //! opposes sliding, read positive by the tangential cell for positive sliding velocity. The
 //! models are symmetric in the sliding direction, so they are evaluated at |v|.
+//!
+//! A Dahl contact built with [`Contact::in_time`] (the plant's) is not evaluated through the
+//! periodic steady state: its state f = F / (mu W) is integrated in time across substeps
+//! ([`super::dahl_state`]), and the friction of a substep is mu W times the time average of f
+//! over it. The other models (Coulomb, cube, exponential Coulomb) have no state of their own
+//! and are evaluated as above at every substep.
 
 use sonolube::fx::{Q1_31, Q8_24, Q16_16};
 use sonolube::model::{FrictionModel, ModelError, OperatingPoint};
 use sonolube::scene::{ModelKind, ModelSpec};
+
+use super::dahl_state::DahlState;
 
 /// The contact's state at one instant (ground truth).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -33,6 +41,8 @@ pub struct Contact<M> {
     mu: f32,
     /// (mu_s, alpha_dc in s/m) of the exponential law, `None` for other models.
     exponential: Option<(f32, f32)>,
+    /// The Dahl state integrated in time ([`Contact::in_time`] on a Dahl spec).
+    dahl: Option<DahlState>,
 }
 
 impl<M: FrictionModel> Contact<M> {
@@ -46,6 +56,80 @@ impl<M: FrictionModel> Contact<M> {
             model,
             mu: spec.mu as f32,
             exponential,
+            dahl: None,
+        }
+    }
+
+    /// The plant's contact: as [`Self::new`], and for a Dahl spec the state integrated in time
+    /// ([`super::dahl_state`]), starting in steady sliding at `normal_n` (N) and
+    /// `velocity_m_per_s` (m/s) without vibration; `full_scale_amplitude_m` is the actuator's
+    /// x_a at amplitude 1. Errors: the Dahl spec's values out of their domain (mu, k_t, x_a
+    /// <= 0, alpha outside (0, 20]).
+    pub fn in_time(
+        model: M,
+        spec: &ModelSpec,
+        full_scale_amplitude_m: f64,
+        normal_n: f32,
+        velocity_m_per_s: f32,
+    ) -> Result<Self, ModelError> {
+        let mut contact = Self::new(model, spec);
+        if spec.kind == ModelKind::Dahl {
+            let stiffness = spec.k_t_n_per_m.ok_or(ModelError::OutOfDomain {
+                input: "k_t",
+                reason: "a Dahl contact needs its tangential stiffness",
+            })?;
+            contact.dahl = Some(DahlState::new(
+                spec.mu,
+                stiffness,
+                spec.dahl_alpha.unwrap_or(1.0),
+                full_scale_amplitude_m,
+                normal_n,
+                velocity_m_per_s,
+            )?);
+        }
+        Ok(contact)
+    }
+
+    /// The Dahl state integrated in time, if this contact has one.
+    pub fn dahl_state(&self) -> Option<&DahlState> {
+        self.dahl.as_ref()
+    }
+
+    /// The contact over a substep of `dt_s` with the load `normal_n` (N), the sliding velocity
+    /// `velocity_m_per_s` (m/s, signed), the vibration amplitude `amplitude` (fraction of full
+    /// scale) and its frequency `frequency_hz` held. A contact with a Dahl state steps it
+    /// through the substep and reports mu W times the time average of f (the ratio is that
+    /// average times sgn(v), 1 without sliding); the others are [`Self::evaluate`]d.
+    pub fn advance(
+        &mut self,
+        normal_n: f32,
+        velocity_m_per_s: f32,
+        amplitude: f32,
+        frequency_hz: f32,
+        dt_s: f32,
+    ) -> ContactTruth {
+        let Some(state) = self.dahl.as_mut() else {
+            return self.evaluate(normal_n, velocity_m_per_s, amplitude);
+        };
+        let mean = state.advance(normal_n, velocity_m_per_s, amplitude, frequency_hz, dt_s);
+        let natural_friction_n = self.mu * normal_n.max(0.0);
+        let ratio = if velocity_m_per_s > 0.0 {
+            mean
+        } else if velocity_m_per_s < 0.0 {
+            -mean
+        } else {
+            1.0
+        };
+        ContactTruth {
+            // The elastic force is there whether or not the contact slides (F = k_t z).
+            friction_n: if natural_friction_n > 0.0 {
+                mean * natural_friction_n
+            } else {
+                0.0
+            },
+            natural_friction_n,
+            ratio,
+            error: None,
         }
     }
 
