@@ -62,6 +62,10 @@ pub struct Settings {
     /// 0 for none. The prediction passes the same lag as the measurement
     /// (`tuning.rs` says why it is not lumped into the envelope).
     pub sensor_lag_s: f64,
+    /// Time constant of the contact's own friction transient, s: a Dahl contact's friction
+    /// relaxes over the slip length `mu W / k_t`, at the sliding speed in `mu W / (k_t v)`
+    /// (physics-notes; `tuning.rs`); 0 for a rigid contact. The prediction passes it first.
+    pub contact_lag_s: f64,
     /// Slew limit: time to change the command by full scale, s.
     pub slew_full_scale_s: f64,
     /// Soft start: time for the ceiling to rise by full scale, s.
@@ -126,6 +130,7 @@ impl Settings {
         envelope_time_constant_s: 0.8e-3,
         response_time_constant_s: 0.25e-3,
         sensor_lag_s: 0.0,
+        contact_lag_s: 0.0,
         slew_full_scale_s: 0.5e-3,
         ramp_up_full_scale_s: 5e-3,
         ramp_down_full_scale_s: 5e-3,
@@ -200,6 +205,8 @@ pub struct Config {
     pub(super) shaper: ShaperConfig,
     /// The tangential cell's lag, applied to the prediction; `None` without one.
     pub(super) sensor_lag: Option<LowPassCoef>,
+    /// The contact's relaxation lag, applied to the prediction; `None` without one.
+    pub(super) contact_lag: Option<LowPassCoef>,
     pub(super) ramp: RampConfig,
     pub(super) gains: GainSchedule,
     pub(super) limit: AmplitudeLimit,
@@ -321,6 +328,15 @@ impl Config {
                 period,
             )
             .map_err(ConfigError::Shaper)?,
+            contact_lag: if s.contact_lag_s == 0.0 {
+                None
+            } else {
+                let lag = LowPassCoef::from_time_constant(s.contact_lag_s, period);
+                Some(lag.map_err(|error| ConfigError::Filter {
+                    setting: "contact_lag_s",
+                    error,
+                })?)
+            },
             sensor_lag: if s.sensor_lag_s == 0.0 {
                 None
             } else {

@@ -159,7 +159,7 @@ pub use supervisor::{Contact, RampConfig, Supervisor};
 pub use target::{ForceQ, PreparedTarget};
 pub use tuning::{
     DECLARED_MODEL_MISMATCH, FORCE_FILTER_HZ, HOLD_LAG_MULTIPLE, NATURAL_LEARN_S,
-    NATURAL_PRIOR_WEIGHT, SLIDING_DEBOUNCE_S, STEADY_GAINS, VELOCITY_FILTER_HZ,
-    controller_settings, noise_limited_ki_per_s, observation_lag_s, ratio_noise,
+    NATURAL_PRIOR_WEIGHT, SLIDING_DEBOUNCE_S, STEADY_GAINS, VELOCITY_FILTER_HZ, contact_lag_s,
+    controller_settings, noise_limited_ki_per_s, noise_rms_error, observation_lag_s, ratio_noise,
     sampled_ki_cap_per_s, tuned,
 };

@@ -82,6 +82,21 @@ pub const STEADY_GAINS: (f64, f64) = (0.1, 300.0);
 /// x0.8, and the mismatch grid's range).
 pub const DECLARED_MODEL_MISMATCH: f64 = 0.2;
 
+/// The time constant of a compliant contact's friction transient, s: a Dahl contact (alpha 1,
+/// seed 003 eqs 5-7) relaxes its friction over the slip length `mu W / k_t`, covered at the
+/// sliding speed in `mu W / (k_t v)`. From the controller's model (its `mu` and `k_t`) at the
+/// load and speed `load_n`, `speed_m_per_s`; 0 for a rigid contact (no `k_t`) or no sliding.
+/// `compliant` (mu 0.2, W 4.155 N, k_t 0.056 N/um, 0.038 m/s): 0.39 ms, as slow as the
+/// envelope; the reference's Mindlin k_t (25 N/um): 0.9 us.
+pub fn contact_lag_s(mu: f64, k_t_n_per_m: Option<f64>, load_n: f64, speed_m_per_s: f64) -> f64 {
+    match k_t_n_per_m {
+        Some(k_t) if k_t > 0.0 && load_n > 0.0 && speed_m_per_s > 0.0 => {
+            mu * load_n / (k_t * speed_m_per_s)
+        }
+        _ => 0.0,
+    }
+}
+
 /// How long the fast gains are held, in observation lags ([`observation_lag_s`]): the observed
 /// model error rises with the lag chain's step response, so the hold lasts until it is within
 /// about e^-3 (5 %) of its new value; after that it is constant and the gain falls by the
@@ -89,10 +104,12 @@ pub const DECLARED_MODEL_MISMATCH: f64 = 0.2;
 pub const HOLD_LAG_MULTIPLE: f64 = 3.0;
 
 /// The lag chain the PI sees the model error through, s: the drive's envelope with the lead
-/// (`response_time_constant_s`), the tangential cell's lag and the force filter. The
+/// (`response_time_constant_s`), the contact's relaxation ([`contact_lag_s`]), the tangential
+/// cell's lag and the force filter. The
 /// prediction passes the same stages, so the chain delays the model error, not the loop.
 pub fn observation_lag_s(s: &Settings) -> f64 {
     s.response_time_constant_s
+        + s.contact_lag_s
         + s.sensor_lag_s
         + 1.0 / (core::f64::consts::TAU * s.tangential_bandwidth_hz)
 }
@@ -106,6 +123,18 @@ pub fn ratio_noise(s: &Settings) -> f64 {
     libm::sqrt(
         libm::pow(s.tangential_noise_n / friction, 2.0) + libm::pow(s.normal_noise_n / load, 2.0),
     )
+}
+
+/// The steady RMS error of the friction the cells' noise predicts, as a fraction of the
+/// target: a reduction or ratio target is relative to mu0, learned as the mean of the samples
+/// taken sliding with the drive off for `learn_s` before the target changes. Its standard error,
+/// `sigma_r / sqrt(n)` ([`ratio_noise`] at the design load, `n = learn_s / T` samples: the
+/// force filter has unit gain at DC, so averaging its output over many time constants keeps
+/// the variance of the raw mean), is a steady error of the held friction no feedback sees.
+/// Returns `None` when no sample is learned (`learn_s < T`).
+pub fn noise_rms_error(s: &Settings, learn_s: f64) -> Option<f64> {
+    let samples = libm::floor(learn_s / s.period_s);
+    (samples >= 1.0).then(|| ratio_noise(s) / libm::sqrt(samples))
 }
 
 /// The fast integral gain the noise allows, 1/s: the steady gain of a Kalman-Bucy filter of
@@ -233,6 +262,12 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
         natural_prior_weight: NATURAL_PRIOR_WEIGHT,
         envelope_time_constant_s: envelope,
         sensor_lag_s: cell_lag_s,
+        contact_lag_s: contact_lag_s(
+            scene.controller.natural_coefficient(start_speed),
+            scene.controller.k_t_n_per_m,
+            scene.normal_load_n.first().map_or(0.0, |p| p.value),
+            start_speed,
+        ),
         // The lead cannot make the envelope slower than it is.
         response_time_constant_s: libm::fmin(reference.response_time_constant_s, envelope),
         kp,
@@ -260,6 +295,22 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
 mod tests {
     use super::*;
     use crate::scene::find;
+
+    #[test]
+    fn the_predicted_error_grows_with_the_noise_and_falls_with_the_learning() {
+        let s = controller_settings(find("reference").expect("built in"));
+        // sigma_r = sqrt((0.01 / (0.2 x 4.155))^2 + (0.05 / 4.155)^2) = 1.70 %; 40 samples.
+        let e = noise_rms_error(&s, 4e-3).expect("learned");
+        assert!((e - 0.017_02 / 40f64.sqrt()).abs() < 1e-5, "{e}");
+        let noisy = Settings {
+            tangential_noise_n: 0.02,
+            normal_noise_n: 0.1,
+            ..s
+        };
+        assert!((noise_rms_error(&noisy, 4e-3).expect("learned") / e - 2.0).abs() < 1e-9);
+        assert!((e / noise_rms_error(&s, 16e-3).expect("learned") - 2.0).abs() < 1e-9);
+        assert_eq!(noise_rms_error(&s, 0.5e-4), None);
+    }
 
     #[test]
     fn the_fast_gain_follows_the_noise_and_the_mismatch() {
@@ -332,11 +383,26 @@ mod tests {
             "{}",
             s.ki_fast_per_s
         );
+        // (three lags: 0.25 ms + 0.87 us of contact, 0.2 x 4.155 N / (25 N/um x 0.038 m/s),
+        // + 79.6 us + 0.637 ms.)
         assert!(
-            (s.boost_hold_s - 3.0 * 0.966_2e-3).abs() < 1e-6,
+            (s.contact_lag_s - 0.875e-6).abs() < 1e-9,
+            "{}",
+            s.contact_lag_s
+        );
+        assert!(
+            (s.boost_hold_s - 3.0 * 0.967_1e-3).abs() < 1e-6,
             "{}",
             s.boost_hold_s
         );
+        // The compliant contact's own k_t (0.056 N/um): 0.39 ms, in the chain.
+        let compliant = controller_settings(find("compliant").expect("built in"));
+        assert!(
+            (compliant.contact_lag_s - 0.3905e-3).abs() < 1e-6,
+            "{}",
+            compliant.contact_lag_s
+        );
+        assert!((observation_lag_s(&compliant) - observation_lag_s(&s) - 0.3896e-3).abs() < 1e-6);
         assert!((s.tangential_force_range_n - 2.2).abs() < 1e-12);
         assert_eq!(s.velocity_range_m_s, 5.0);
         assert!(crate::control::Config::new(&s).is_ok());
