@@ -262,12 +262,15 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
         natural_prior_weight: NATURAL_PRIOR_WEIGHT,
         envelope_time_constant_s: envelope,
         sensor_lag_s: cell_lag_s,
+        // The slowest contact the declared mismatch allows (k_t down to (1 - m) of the
+        // model's): a prediction faster than the plant reads as a plant short of reduction and
+        // the fast integral overdrives into overshoot; a slower one only delays its learning.
         contact_lag_s: contact_lag_s(
             scene.controller.natural_coefficient(start_speed),
             scene.controller.k_t_n_per_m,
             scene.normal_load_n.first().map_or(0.0, |p| p.value),
             start_speed,
-        ),
+        ) / (1.0 - DECLARED_MODEL_MISMATCH),
         // The lead cannot make the envelope slower than it is.
         response_time_constant_s: libm::fmin(reference.response_time_constant_s, envelope),
         kp,
@@ -383,26 +386,27 @@ mod tests {
             "{}",
             s.ki_fast_per_s
         );
-        // (three lags: 0.25 ms + 0.87 us of contact, 0.2 x 4.155 N / (25 N/um x 0.038 m/s),
-        // + 79.6 us + 0.637 ms.)
+        // (three lags: 0.25 ms + 1.09 us of contact, 0.2 x 4.155 N / (0.8 x 25 N/um x
+        // 0.038 m/s), + 79.6 us + 0.637 ms.)
         assert!(
-            (s.contact_lag_s - 0.875e-6).abs() < 1e-9,
+            (s.contact_lag_s - 1.093_6e-6).abs() < 1e-9,
             "{}",
             s.contact_lag_s
         );
         assert!(
-            (s.boost_hold_s - 3.0 * 0.967_1e-3).abs() < 1e-6,
+            (s.boost_hold_s - 3.0 * 0.967_3e-3).abs() < 1e-6,
             "{}",
             s.boost_hold_s
         );
-        // The compliant contact's own k_t (0.056 N/um): 0.39 ms, in the chain.
+        // The compliant contact's own k_t (0.056 N/um): 0.39 ms, 0.49 ms at 0.8 k_t, in the
+        // chain.
         let compliant = controller_settings(find("compliant").expect("built in"));
         assert!(
-            (compliant.contact_lag_s - 0.3905e-3).abs() < 1e-6,
+            (compliant.contact_lag_s - 0.488_1e-3).abs() < 1e-6,
             "{}",
             compliant.contact_lag_s
         );
-        assert!((observation_lag_s(&compliant) - observation_lag_s(&s) - 0.3896e-3).abs() < 1e-6);
+        assert!((observation_lag_s(&compliant) - observation_lag_s(&s) - 0.487_0e-3).abs() < 1e-6);
         assert!((s.tangential_force_range_n - 2.2).abs() < 1e-12);
         assert_eq!(s.velocity_range_m_s, 5.0);
         assert!(crate::control::Config::new(&s).is_ok());
