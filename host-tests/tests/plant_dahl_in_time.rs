@@ -351,3 +351,38 @@ fn the_error_converges_with_the_nodes_per_stretch() {
         assert!(errors[3] < BOUND, "{errors:?}");
     }
 }
+
+/// At vibration frequencies whose period is not the substep (20 kHz: half a period per 25 us
+/// substep; 30 kHz: 0.75; 60 kHz: 1.5) the friction handed to the cells is the mean over the
+/// last vibration period, not over the substep: in the steady state it is the same at every
+/// substep (no ripple at the vibration frequency for the cells to alias) and equals the steady
+/// state, on the stiff contact of the `reference` scene.
+#[test]
+fn the_cells_see_the_mean_over_the_last_vibration_period() {
+    for hz in [20e3f32, 30e3, 60e3] {
+        let mut state = DahlState::new(0.24, 2e7, 1.0, 0.965e-6, 4.155, 0.038).expect("state");
+        let means: Vec<f32> = (0..400)
+            .map(|_| state.advance(4.155, 0.038, 0.46, hz, 2.5e-5))
+            .collect();
+        let steady = dahl_steady(&DahlSteadyInput {
+            friction_coefficient: 0.24,
+            normal_load: 4.155,
+            tangential_stiffness: 2e7,
+            sliding_velocity: 0.038,
+            vibration_velocity: std::f64::consts::TAU * f64::from(hz) * 0.46 * 0.965e-6,
+            frequency: f64::from(hz),
+            shape_exponent: 1.0,
+        })
+        .expect("steady")
+        .friction_ratio
+        .expect("sliding");
+        let last = &means[390..];
+        eprintln!("{hz} Hz: last means {last:?}, steady state {steady:.6}");
+        for &mean in last {
+            assert!(
+                (f64::from(mean) - steady).abs() < BOUND,
+                "{hz}: {mean} vs {steady}"
+            );
+        }
+    }
+}

@@ -8,7 +8,7 @@
 //! sonolube scene NAME [--out DIR] [--file PATH.toml]
 //! sonolube scene --all [--out DIR]
 //! sonolube scene NAME|--all --seeds N|A-B [--plot PATH.svg]
-//! sonolube scene NAME --mismatch|--envelope|--noise [--seeds N|A-B] [--out DIR]
+//! sonolube scene NAME --mismatch|--envelope|--noise|--resonators [--seeds N|A-B] [--out DIR]
 //! sonolube scene NAME --mismatch --pinned [--seeds N|A-B]
 //! ```
 //!
@@ -16,7 +16,7 @@
 //! transducer's complex envelope): a resonance known only to +-0.5 % must be followed.
 //! `--pinned` holds the drive at the scene's frequency instead.
 //!
-//! `--seeds`, `--mismatch`, `--envelope` and `--noise` are the robustness sweeps ([`robust`]):
+//! `--seeds`, `--mismatch`, `--envelope`, `--noise` and `--resonators` are the robustness sweeps ([`robust`]):
 //! many runs over every core, a table per criterion (pass rate, percentiles, worst run), a
 //! closing one-line summary, exit 0 only when every run passes.
 //!
@@ -77,7 +77,7 @@ pub use report::{model_line, model_name, short};
 const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml] [--model VARIANT]\n       \
                      sonolube scene --all [--out DIR]\n       \
                      sonolube scene NAME|--all --seeds N|A-B [--plot PATH.svg]\n       \
-                     sonolube scene NAME --mismatch|--envelope|--noise [--seeds N|A-B] [--out DIR]\n       \
+                     sonolube scene NAME --mismatch|--envelope|--noise|--resonators [--seeds N|A-B] [--out DIR]\n       \
                      sonolube scene NAME --mismatch --pinned [--seeds N|A-B]\n\
                      exit status: 0 every criterion passes (every run of a sweep); 1 one fails, \
                      or the scene cannot run (a file that cannot be read or is invalid, values \
@@ -98,13 +98,14 @@ pub fn run(args: &[String]) -> ExitCode {
     while let Some(arg) = rest.next() {
         match arg.as_str() {
             "--all" => all = true,
-            "--mismatch" | "--envelope" | "--noise" => {
+            "--mismatch" | "--envelope" | "--noise" | "--resonators" => {
                 if sweep.is_some() {
-                    return usage("one of --mismatch, --envelope, --noise at a time");
+                    return usage("one of --mismatch, --envelope, --noise, --resonators at a time");
                 }
                 sweep = Some(match arg.as_str() {
                     "--mismatch" => robust::Sweep::Mismatch(robust::GridDrive::FreqAuto),
                     "--envelope" => robust::Sweep::Envelope,
+                    "--resonators" => robust::Sweep::Resonators,
                     _ => robust::Sweep::Noise,
                 });
             }
@@ -146,14 +147,16 @@ pub fn run(args: &[String]) -> ExitCode {
     }
     let robust = seeds.is_some() || sweep.is_some();
     if plot.is_some() && !robust {
-        return usage("--plot goes with --seeds, --mismatch, --envelope or --noise");
+        return usage("--plot goes with --seeds, --mismatch, --envelope, --noise or --resonators");
     }
     if all {
         if name.is_some() || file.is_some() || forced.is_some() {
             return usage("--all takes no scene name, --file or --model");
         }
         if sweep.is_some() {
-            return usage("--mismatch, --envelope and --noise take one scene NAME, not --all");
+            return usage(
+                "--mismatch, --envelope, --noise and --resonators take one scene NAME, not --all",
+            );
         }
         if let Some(seeds) = &seeds {
             let scenes = robust::builtin();

@@ -9,8 +9,9 @@
 //! A Dahl contact built with [`Contact::in_time`] (the plant's) is not evaluated through the
 //! periodic steady state: its state f = F / (mu W) is integrated in time across substeps
 //! ([`super::dahl_state`]), and the friction of a substep is mu W times the time average of f
-//! over it. The other models (Coulomb, cube, exponential Coulomb) have no state of their own
-//! and are evaluated as above at every substep.
+//! over the last vibration period ending with it. The other models (Coulomb, cube,
+//! exponential Coulomb) have no state of their own and are evaluated as above at every
+//! substep.
 
 use sonolube::fx::{Q1_31, Q8_24, Q16_16};
 use sonolube::model::{FrictionModel, ModelError, OperatingPoint};
@@ -98,8 +99,9 @@ impl<M: FrictionModel> Contact<M> {
     /// The contact over a substep of `dt_s` with the load `normal_n` (N), the sliding velocity
     /// `velocity_m_per_s` (m/s, signed), the vibration amplitude `amplitude` (fraction of full
     /// scale) and its frequency `frequency_hz` held. A contact with a Dahl state steps it
-    /// through the substep and reports mu W times the time average of f (the ratio is that
-    /// average times sgn(v), 1 without sliding); the others are [`Self::evaluate`]d.
+    /// through the substep and reports mu W times the time average of f over the last
+    /// vibration period (the ratio is that average times sgn(v), 1 without sliding); the
+    /// others are [`Self::evaluate`]d.
     pub fn advance(
         &mut self,
         normal_n: f32,

@@ -95,10 +95,28 @@ pub struct DahlState {
     clamped_load_drops: u32,
     /// Nodes per stretch ([`NODES_PER_STRETCH`] unless set for a convergence measurement).
     nodes: u32,
+    /// The last substeps walked (ring; `newest` is the latest).
+    history: [Option<Record>; HISTORY],
+    newest: usize,
+}
+
+/// Substeps recorded for [`DahlState::period_mean`]: a period of up to 7 substeps is averaged
+/// whole (5.7 kHz at 25 us substeps), a longer one over 7 substeps.
+const HISTORY: usize = 8;
+
+/// A substep as walked: its start and its drive.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Record {
+    start_force_ratio: Q2_30,
+    start_phase: u32,
+    drive: Drive,
+    span: u64,
+    /// The load f was referred to over the substep, N.
+    load_n: f32,
 }
 
 /// The geometry of one substep's drive.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 struct Drive {
     /// Turning phase T1 (turns x 2^32) of a reversing drive: forward on (-T1, T1); `None`
     /// without reversal.
@@ -179,6 +197,8 @@ impl DahlState {
             load_n: if loaded { normal_n } else { 0.0 },
             clamped_load_drops: 0,
             nodes: NODES_PER_STRETCH,
+            history: [None; HISTORY],
+            newest: 0,
         })
     }
 
@@ -209,7 +229,9 @@ impl DahlState {
     /// Advances the contact by `dt_s` with the load `normal_n` (N), the sliding velocity
     /// `velocity_m_per_s` (m/s, signed), the vibration amplitude `amplitude` (fraction of full
     /// scale, clamped to [0, 1], NaN as 0) and the vibration frequency `frequency_hz` held.
-    /// Returns the time average of f over the step (f at the end when the step is empty).
+    /// Returns the time average of the force over the last vibration period ending with the
+    /// step, in units of the present mu W (over the step itself without vibration; f at the end
+    /// when the step is empty).
     /// Non-finite or non-positive loads unload the contact (f = 0); a non-finite velocity
     /// counts as no sliding; a non-finite or non-positive frequency as no vibration.
     pub fn advance(
@@ -229,6 +251,7 @@ impl DahlState {
         if !(normal_n > 0.0 && normal_n.is_finite()) {
             self.force_ratio = Q2_30::ZERO;
             self.load_n = 0.0;
+            self.history = [None; HISTORY];
             self.phase = self.phase.wrapping_add(span as u32);
             return 0.0;
         }
@@ -254,10 +277,12 @@ impl DahlState {
         }
         if amplitude_m <= 0.0 || span == 0 {
             // No vibration: one stretch of travel |v| dt, exact for any law whose decay is
-            // linear in time (alpha = 1), and the same rule as every interval otherwise.
+            // linear in time (alpha = 1), and the same rule as every interval otherwise; no
+            // ripple to average out, and the history restarts.
             let (mean, next) = self.interval(kappa_per_m * libm::fabsf(v) * dt_s, v > 0.0);
             self.force_ratio = next;
             self.phase = self.phase.wrapping_add(span as u32);
+            self.history = [None; HISTORY];
             return mean;
         }
         let omega = TAU * frequency_hz;
@@ -277,7 +302,16 @@ impl DahlState {
             amplitude_m,
             kappa_per_m,
         };
-        self.walk(&drive, span)
+        self.newest = (self.newest + 1) % HISTORY;
+        self.history[self.newest] = Some(Record {
+            start_force_ratio: self.force_ratio,
+            start_phase: self.phase,
+            drive,
+            span,
+            load_n: self.load_n,
+        });
+        let (whole, tail) = self.walk(&drive, span, span.saturating_sub(TURN));
+        self.period_mean(span, whole, tail)
     }
 
     /// Refers f to the load `normal_n` (> 0): F continuous, f scaled by W_old / W_new.
@@ -341,10 +375,14 @@ impl DahlState {
         }
     }
 
-    /// Steps the state through `span` (turns x 2^32) of drive phase; returns the mean of f.
-    fn walk(&mut self, drive: &Drive, span: u64) -> f32 {
+    /// Steps the state through `span` (turns x 2^32) of drive phase; returns the integrals of
+    /// f over the whole span and over its part from `tail_start` (phase units from the start)
+    /// on, in f x phase units.
+    fn walk(&mut self, drive: &Drive, span: u64, tail_start: u64) -> (f32, f32) {
         let mut remaining = span;
         let mut weighted = 0.0f32;
+        let mut tail = 0.0f32;
+        let mut done = 0u64;
         let mut sin_here = sin_bits(self.phase);
         while remaining > 0 {
             let stretch = self.stretch_at(drive, self.phase);
@@ -354,7 +392,11 @@ impl DahlState {
                 j += 1;
             }
             loop {
-                let target = stretch.node(j).min(within + remaining);
+                let mut target = stretch.node(j).min(within + remaining);
+                if done < tail_start {
+                    // The tail's start is a node too.
+                    target = target.min(within + (tail_start - done));
+                }
                 let step = target - within;
                 let next_phase = self.phase.wrapping_add(step as u32);
                 let sin_next = sin_bits(next_phase);
@@ -365,18 +407,69 @@ impl DahlState {
                 let (mean, next) =
                     self.interval(drive.kappa_per_m * along.max(0.0), stretch.forward);
                 weighted += mean * step as f32;
+                if done >= tail_start {
+                    tail += mean * step as f32;
+                }
                 self.force_ratio = next;
                 self.phase = next_phase;
                 sin_here = sin_next;
                 remaining -= step;
+                done += step;
                 within = target;
                 if remaining == 0 || within >= stretch.length {
                     break;
                 }
-                j += 1;
+                if stretch.node(j) <= within {
+                    j += 1;
+                }
             }
         }
-        weighted / span as f32
+        (weighted, tail)
+    }
+
+    /// The mean of f over the last vibration period (one turn of phase) ending now, after a
+    /// substep walked with `drive` over `span` whose whole integral is `whole` and whose
+    /// last turn's integral is `tail`: a substep shorter than a period reaches back into the
+    /// substeps before it, walked again from their recorded start (the same bits), as far as
+    /// the history holds.
+    fn period_mean(&self, span: u64, whole: f32, tail: f32) -> f32 {
+        if span >= TURN {
+            return tail / TURN as f32;
+        }
+        // The records before this substep's (newest first) and how much of each counts (its
+        // last part), until a turn is covered.
+        let mut needed = TURN - span;
+        let mut reach: [Option<(Record, u64)>; HISTORY] = [None; HISTORY];
+        let mut count = 0;
+        for back in 1..HISTORY {
+            if needed == 0 {
+                break;
+            }
+            let index = (self.newest + HISTORY - back) % HISTORY;
+            let Some(record) = self.history[index] else {
+                break;
+            };
+            let take = record.span.min(needed);
+            reach[count] = Some((record, take));
+            count += 1;
+            needed -= take;
+        }
+        let mut integral = whole;
+        let mut covered = span;
+        // Oldest first, each walked again from its recorded start; only its last `take` counts.
+        for (record, take) in reach[..count].iter().rev().flatten() {
+            let mut shadow = DahlState {
+                force_ratio: record.start_force_ratio,
+                phase: record.start_phase,
+                history: [None; HISTORY],
+                ..self.clone()
+            };
+            let (_, part) = shadow.walk(&record.drive, record.span, record.span - take);
+            // The force is what is averaged: f of an earlier load counts as mu W_then f.
+            integral += part * (record.load_n / self.load_n);
+            covered += take;
+        }
+        integral / covered as f32
     }
 
     /// One interval of travel exponent `y` (>= 0) in direction `forward`: the mean of f over

@@ -7,6 +7,7 @@
 //! sonolube scene NAME --mismatch [--seeds N|A-B]
 //! sonolube scene NAME --envelope [--seeds N|A-B] [--out DIR]
 //! sonolube scene NAME --noise [--seeds N|A-B]
+//! sonolube scene NAME --resonators [--seeds N|A-B]
 //! ```
 //!
 //! Each prints, per scene and criterion, the pass rate, the 50th, 90th and 99th percentiles
@@ -17,7 +18,7 @@
 use std::path::Path;
 use std::process::ExitCode;
 
-use sonolube::scene::{SCENES, Scene};
+use sonolube::scene::{Criterion, SCENES, Scene};
 use sonolube_sim::RunSummary;
 
 pub use super::grid::GridDrive;
@@ -42,6 +43,8 @@ pub enum Sweep {
     Envelope,
     /// Sensor noise levels ([`NOISE_LEVELS_PCT`]).
     Noise,
+    /// Other resonators: f0 in [`RESONATOR_F0_HZ`] x Q in [`RESONATOR_Q`] ([`Resonator`]).
+    Resonators,
 }
 
 /// Parses `N` (seeds 1 to N) or `A-B` (A to B, inclusive); at most 100 000 seeds.
@@ -104,6 +107,7 @@ pub fn run(
                 sweep_runs(scene, &runs, jobs)
             }
             Sweep::Noise => noise_sweep(scene, seeds, jobs),
+            Sweep::Resonators => resonator_sweep(scene, seeds, jobs),
             Sweep::Envelope => envelope(scene, seeds, jobs, out),
         };
         match result {
@@ -235,6 +239,270 @@ fn noise_sweep(scene: &Scene<'_>, seeds: &[u64], jobs: usize) -> Result<Done, St
     );
     let stats = criterion_stats(scene, &runs, &results);
     Ok(Done { stats, results })
+}
+
+/// Resonance frequencies of the resonator sweep, Hz (the stack's 20-60 kHz range, seed 003
+/// Table 1).
+pub const RESONATOR_F0_HZ: [f64; 5] = [20e3, 28e3, 40e3, 50e3, 60e3];
+/// Quality factors of the resonator sweep.
+pub const RESONATOR_Q: [f64; 5] = [30.0, 60.0, 100.0, 200.0, 300.0];
+
+/// The scene's stack on another resonator (f0, Q), within the stack's ratings.
+///
+/// The stack keeps its clamped capacitance C0, its ratings (V_max, I_max), its motional
+/// inductance L1 = Q R1 / w0 (the modal mass over the squared force factor) and its force
+/// factor N (motional current per vibration velocity), both taken from the scene at its own
+/// (f0, Q, R1) and full scale (V, x_a): N = (V / R1) / (w0 x_a). On the other resonator:
+/// - R1 = w0 L1 / Q (the motional branch's loss at that f0 and Q);
+/// - the full-scale voltage is the largest both ratings allow at resonance, V = min(V_max,
+///   I_max / |1/R1 + j w0 C0|) (the scene loader's rule, `scene-toml` hardware.rs: the drive
+///   must not exceed I_max at full command); the capacitive part alone is 2 pi f0 C0 V,
+///   which is what I_max = 2 pi f C V means at each f0 (1.75 A at 60 kHz and V_max);
+/// - the full-scale amplitude follows from the motional current: x_a = (V / R1) / (N w0),
+///   so the full-scale vibration velocity stays near I_max / N wherever the current limits;
+/// - the drive runs `freq auto` (search, then track) on the complex envelope, from the
+///   nominal f0;
+/// - the settle limit is max(the scene's, 2 tau), tau = 2 Q / w0 = Q / (pi f0), the envelope
+///   time constant (physics-notes §7).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Resonator {
+    /// Resonance f0, Hz.
+    pub resonance_hz: f64,
+    /// Quality factor.
+    pub quality_factor: f64,
+    /// Motional resistance R1, ohm.
+    pub motional_resistance_ohm: f64,
+    /// Full-scale voltage, V.
+    pub full_scale_voltage_v: f64,
+    /// Current at full scale at resonance, A.
+    pub full_scale_current_a: f64,
+    /// Capacitive current at V_max, 2 pi f0 C0 V_max, A.
+    pub capacitive_current_at_max_v_a: f64,
+    /// Full-scale vibration amplitude, m.
+    pub full_scale_amplitude_m: f64,
+    /// Envelope time constant Q / (pi f0), s.
+    pub time_constant_s: f64,
+    /// The settle limit, s.
+    pub settle_s: f64,
+}
+
+impl Resonator {
+    /// The scene's stack on the resonator (`resonance_hz`, `quality_factor`).
+    pub fn of(scene: &Scene<'_>, resonance_hz: f64, quality_factor: f64) -> Result<Self, String> {
+        let t = &scene.transducer;
+        let a = &scene.actuator;
+        let w_scene = std::f64::consts::TAU * t.resonance_hz;
+        let inductance_h = t.quality_factor * t.motional_resistance_ohm / w_scene;
+        let force_factor = a.full_scale_voltage_v
+            / t.motional_resistance_ohm
+            / (w_scene * a.full_scale_amplitude_m);
+        let w0 = std::f64::consts::TAU * resonance_hz;
+        let r1 = w0 * inductance_h / quality_factor;
+        let admittance = (1.0 / r1).hypot(w0 * t.clamped_capacitance_f);
+        // Strictly within I_max after rounding (the loader refuses a current above it).
+        let voltage = a
+            .max_voltage_v
+            .min(a.max_current_a / admittance * (1.0 - 1e-9));
+        let amplitude = voltage / r1 / (force_factor * w0);
+        let tau = quality_factor / (std::f64::consts::PI * resonance_hz);
+        let scene_settle = scene.criteria.iter().find_map(|c| match c {
+            Criterion::Settle { within_s, .. } => Some(*within_s),
+            _ => None,
+        });
+        let settle_s = scene_settle
+            .ok_or("the scene has no settle criterion to widen")?
+            .max(2.0 * tau);
+        let finite = [r1, voltage, amplitude, tau, settle_s];
+        if finite.iter().any(|x| !x.is_finite() || *x <= 0.0) {
+            return Err(format!(
+                "the scene's transducer and actuator give no resonator at {resonance_hz} Hz, Q {quality_factor}"
+            ));
+        }
+        Ok(Self {
+            resonance_hz,
+            quality_factor,
+            motional_resistance_ohm: r1,
+            full_scale_voltage_v: voltage,
+            full_scale_current_a: voltage * admittance,
+            capacitive_current_at_max_v_a: w0 * t.clamped_capacitance_f * a.max_voltage_v,
+            full_scale_amplitude_m: amplitude,
+            time_constant_s: tau,
+            settle_s,
+        })
+    }
+
+    /// `scene` on this resonator, its criteria replaced by `criteria` (the scene's with the
+    /// settle limit widened: [`Self::criteria`]).
+    pub fn apply<'a>(&self, scene: &Scene<'a>, criteria: &'a [Criterion]) -> Scene<'a> {
+        let mut s = *scene;
+        s.transducer.resonance_hz = self.resonance_hz;
+        s.transducer.drive_hz = self.resonance_hz;
+        s.transducer.quality_factor = self.quality_factor;
+        s.transducer.motional_resistance_ohm = self.motional_resistance_ohm;
+        s.transducer.shift.bvd_envelope = true;
+        s.transducer.shift.freq_auto = true;
+        s.actuator.full_scale_voltage_v = self.full_scale_voltage_v;
+        s.actuator.full_scale_amplitude_m = self.full_scale_amplitude_m;
+        s.criteria = criteria;
+        s
+    }
+
+    /// The scene's criteria with the settle limit at [`Self::settle_s`].
+    pub fn criteria(&self, scene: &Scene<'_>) -> Vec<Criterion> {
+        scene
+            .criteria
+            .iter()
+            .map(|c| match *c {
+                Criterion::Settle { band_pct, .. } => Criterion::Settle {
+                    band_pct,
+                    within_s: self.settle_s,
+                },
+                other => other,
+            })
+            .collect()
+    }
+
+    fn label(&self) -> String {
+        format!(
+            "f0 {:.0} kHz, Q {:.0}",
+            self.resonance_hz / 1e3,
+            self.quality_factor
+        )
+    }
+}
+
+/// The resonator sweep: the scene on every (f0, Q) of [`RESONATOR_F0_HZ`] x [`RESONATOR_Q`]
+/// ([`Resonator`]), on every seed; a table of the resonators and their verdicts.
+fn resonator_sweep(scene: &Scene<'_>, seeds: &[u64], jobs: usize) -> Result<Done, String> {
+    let mut resonators = Vec::new();
+    for f0 in RESONATOR_F0_HZ {
+        for q in RESONATOR_Q {
+            resonators.push(Resonator::of(scene, f0, q)?);
+        }
+    }
+    let criteria: Vec<Vec<Criterion>> = resonators.iter().map(|r| r.criteria(scene)).collect();
+    let mut runs = Vec::new();
+    for (resonator, criteria) in resonators.iter().zip(&criteria) {
+        let changed = resonator.apply(scene, criteria);
+        for &seed in seeds {
+            runs.push(Run {
+                label: if seeds.len() > 1 {
+                    format!("{}, seed {seed}", resonator.label())
+                } else {
+                    resonator.label()
+                },
+                scene: Scene {
+                    noise_seed: seed,
+                    ..changed
+                },
+                calibration: sonolube_sim::COMMISSIONED,
+            });
+        }
+    }
+    println!(
+        "{}: resonators f0 {:?} kHz x Q {:?}, drive freq auto (search, then track), full scale \
+         within V_max {} V and I_max {} A, settle limit max(the scene's, 2 tau), {} runs, {}",
+        scene.name,
+        RESONATOR_F0_HZ.map(|f| f / 1e3),
+        RESONATOR_Q,
+        scene.actuator.max_voltage_v,
+        scene.actuator.max_current_a,
+        runs.len(),
+        seeds_text(seeds)
+    );
+    let results = run_all(&runs, jobs, "resonators");
+    println!(
+        "  {:>6} {:>4} {:>8} {:>7} {:>7} {:>7} {:>8} {:>8} {:>8} {:>9} {:>9} {:>6}  measured \
+         (worst seed)",
+        "f0 kHz",
+        "Q",
+        "tau ms",
+        "R1 ohm",
+        "V fs",
+        "I fs A",
+        "Ic@Vmax",
+        "x_a um",
+        "reach %",
+        "settle ms",
+        "limit ms",
+        "pass",
+    );
+    for (k, resonator) in resonators.iter().enumerate() {
+        let chunk = &results[k * seeds.len()..(k + 1) * seeds.len()];
+        let passed = chunk.iter().filter(|r| is_pass(r)).count();
+        let worst = chunk.iter().find(|r| !is_pass(r)).or(chunk.first());
+        let at_limit_ms = worst
+            .and_then(|r| r.as_ref().ok())
+            .map_or(f64::NAN, |s| f64::from(s.time_at_limit_s) * 1e3);
+        let reach = reachable_reduction_pct(&runs[k * seeds.len()].scene);
+        let measured = chunk.iter().find(|r| !is_pass(r)).or(chunk.first()).map_or(
+            String::new(),
+            |r| match r {
+                Ok(summary) => summary
+                    .verdicts
+                    .iter()
+                    .map(|v| {
+                        let (name, _, unit) = super::sweep::criterion_name(&v.criterion);
+                        match value_of(v.measured) {
+                            Some(x) => format!("{name} {x:.2} {unit}"),
+                            None => format!("{name} -"),
+                        }
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                Err(error) => error.clone(),
+            },
+        );
+        println!(
+            "  {:>6.0} {:>4.0} {:>8.3} {:>7.3} {:>7.2} {:>7.3} {:>8.3} {:>8.3} {:>8.1} {:>9.2} {:>9.1} \
+             {:>6}  {}",
+            resonator.resonance_hz / 1e3,
+            resonator.quality_factor,
+            resonator.time_constant_s * 1e3,
+            resonator.motional_resistance_ohm,
+            resonator.full_scale_voltage_v,
+            resonator.full_scale_current_a,
+            resonator.capacitive_current_at_max_v_a,
+            resonator.full_scale_amplitude_m * 1e6,
+            reach,
+            resonator.settle_s * 1e3,
+            at_limit_ms,
+            format!("{passed}/{}", chunk.len()),
+            measured
+        );
+    }
+    println!(
+        "  (reach: the largest reduction the plant's steady state gives at full scale at the \
+         scene's first load and speed; limit: time with the drive at its ceiling)"
+    );
+    let stats = criterion_stats(scene, &runs, &results);
+    print!("{}", stats_table(&stats));
+    println!("  (the settle row's limit is the scene's; each run is judged on its own, above)");
+    for line in failures(&runs, &results) {
+        println!("  FAIL {line}");
+    }
+    Ok(Done { stats, results })
+}
+
+/// The largest friction reduction, %, the plant's steady-state model gives at full amplitude
+/// at the scene's first load and speed (NaN when it cannot be evaluated).
+fn reachable_reduction_pct(scene: &Scene<'_>) -> f64 {
+    use sonolube::fx::{Q1_31, Q8_24, Q16_16};
+    use sonolube::model::{AnyModel, FrictionModel, OperatingPoint};
+    let (Some(load), Some(speed)) = (
+        scene.normal_load_n.first(),
+        scene.sliding_velocity_m_per_s.first(),
+    ) else {
+        return f64::NAN;
+    };
+    let point = OperatingPoint {
+        normal_force: Q16_16::from_f64_saturating(load.value).value,
+        sliding_velocity: Q8_24::from_f64_saturating(speed.value).value,
+    };
+    AnyModel::new(scene, &scene.plant)
+        .ok()
+        .and_then(|model| model.ratio(&point, Q1_31::MAX).ok())
+        .map_or(f64::NAN, |ratio| 100.0 * (1.0 - ratio.to_f64()))
 }
 
 /// The envelope sweep: a scene file per point, written to `out/envelope/`, run on every seed.
@@ -474,6 +742,39 @@ mod tests {
         );
         assert_eq!(sized.scene.plant, scene.plant);
         assert_eq!(sized.scene.contents, scene.contents);
+    }
+
+    /// On the scene's own resonator the derived stack is the scene's (R1, and the full scale
+    /// within 1 % where the scene's 5.25 V sits just under the current limit); elsewhere both
+    /// ratings hold, and the settle limit is 2 tau once that exceeds the scene's.
+    #[test]
+    fn resonators_keep_the_stack_within_its_ratings() {
+        let scene = sonolube::scene::find("reference").expect("built in");
+        let own = Resonator::of(scene, 40e3, 100.0).unwrap();
+        assert!((own.motional_resistance_ohm - 3.1).abs() < 1e-9);
+        assert!((own.full_scale_voltage_v / 5.25 - 1.0).abs() < 0.01);
+        let ratio = own.full_scale_amplitude_m / scene.actuator.full_scale_amplitude_m;
+        assert!((ratio - own.full_scale_voltage_v / 5.25).abs() < 1e-9);
+        assert!((own.time_constant_s - 0.796e-3).abs() < 1e-6);
+        assert_eq!(own.settle_s, 3e-3);
+        for f0 in RESONATOR_F0_HZ {
+            for q in RESONATOR_Q {
+                let r = Resonator::of(scene, f0, q).unwrap();
+                assert!(r.full_scale_voltage_v <= scene.actuator.max_voltage_v);
+                assert!(r.full_scale_current_a <= scene.actuator.max_current_a);
+                assert!(
+                    (r.settle_s - (2.0 * q / (std::f64::consts::PI * f0)).max(3e-3)).abs() < 1e-15
+                );
+                let criteria = r.criteria(scene);
+                let run = r.apply(scene, &criteria);
+                assert!(run.transducer.shift.freq_auto && run.transducer.shift.bvd_envelope);
+                assert_eq!(run.transducer.drive_hz, f0);
+                assert_eq!(run.plant, scene.plant);
+            }
+        }
+        // The capacitive current at V_max is I_max at 60 kHz (seed 003 Table 1).
+        let top = Resonator::of(scene, 60e3, 100.0).unwrap();
+        assert!((top.capacitive_current_at_max_v_a - 1.75).abs() < 0.01);
     }
 
     #[test]
