@@ -25,7 +25,7 @@
 
 use crate::control::{
     Config, ConfigError, Controller, ExternalFault, Inputs, Output, Sensor, SensorFault,
-    SensorFaultKind, Settings,
+    SensorFaultKind, Settings, gain_schedule, tuned,
 };
 use crate::drive::{Amplitude, Frequency, TimerClock};
 use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
@@ -96,6 +96,9 @@ pub struct Station {
     /// The choice `model` was built from; `None` when the caller gave the model.
     selection: Option<Selection>,
     controller: Controller,
+    /// The settings the controller was built from; the gains are recomputed from them with
+    /// the cells' measured noise after a tare ([`Station::tune_to_cells`]).
+    settings: Settings,
     normal: SensorChannel,
     tangential: SensorChannel,
     drive_hz: f32,
@@ -197,6 +200,7 @@ impl Station {
             model,
             selection,
             controller,
+            settings: *settings,
             normal,
             tangential,
             drive_hz: scene.transducer.drive_hz as f32,
@@ -450,7 +454,8 @@ impl Station {
                 }
                 self.normal = new_normal;
                 self.tangential = new_tangential;
-                Ok(())
+                self.tune_to_cells()
+                    .map_err(|_| cal_failed("measured noise unusable for the tuning"))
             }
             Command::Cal { axis, load_mn } => {
                 self.require_drive_off(command)?;
@@ -537,6 +542,32 @@ impl Station {
     /// ([`crate::settings::capture`]).
     pub fn calibrations(&self) -> (crate::sense::Calibration, crate::sense::Calibration) {
         (self.normal.calibration(), self.tangential.calibration())
+    }
+
+    /// Recomputes the controller's gains by the tuning rule ([`crate::control::tuned`]) with
+    /// the noise the cells' last tare measured (a cell not tared keeps the settings' noise),
+    /// and hands them to the controller bumplessly. The station's `tare` calls it; a
+    /// simulation that commissions the channels directly calls it after. Errors: the rule or
+    /// the gains refused the measured noise (nothing is changed then).
+    pub fn tune_to_cells(&mut self) -> Result<(), ConfigError> {
+        let mut settings = self.settings;
+        if let Some(noise) = self.normal.noise() {
+            settings.normal_noise_n = noise.to_f64();
+        }
+        if let Some(noise) = self.tangential.noise() {
+            settings.tangential_noise_n = noise.to_f64();
+        }
+        let settings = tuned(&settings)?;
+        let gains = gain_schedule(&settings)?;
+        // Always accepted (bumpless in every state).
+        let _ = self.controller.set_gains(gains);
+        self.settings = settings;
+        Ok(())
+    }
+
+    /// The settings the controller's gains were last computed from.
+    pub const fn settings(&self) -> &Settings {
+        &self.settings
     }
 
     /// The two channels (normal, tangential), for commissioning.

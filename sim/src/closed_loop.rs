@@ -206,6 +206,9 @@ impl<'a> ClosedLoop<'a> {
         let (normal, tangential) = station.channels_mut();
         commission(normal, &scene.normal_cell, calibration, seed, 0)?;
         commission(tangential, &scene.tangential_cell, calibration, seed, 1)?;
+        // The tare measured each cell's noise: the gains follow it, as the station's `tare`
+        // makes them.
+        station.tune_to_cells().map_err(|_| SimError::Calibration)?;
         Ok(Self {
             scene: *scene,
             plant,

@@ -90,7 +90,7 @@ pub fn commission(
 mod tests {
     use super::*;
     use crate::sensor_channel;
-    use sonolube::scene::find;
+    use sonolube::scene::{LoadCell, find};
 
     /// Mean force over 2000 samples of a cell settled at `force_n` through `channel`.
     fn mean_reading(channel: &mut SensorChannel, cell: &LoadCell, force_n: f32) -> f64 {
@@ -125,6 +125,33 @@ mod tests {
             let read = mean_reading(&mut calibrated, &cell, force);
             // 0.03 % of 300 N from each burst's noise, 0.02 N from the test's own.
             assert!((read - f64::from(force)).abs() < 0.2, "{force}: {read}");
+        }
+    }
+
+    #[test]
+    fn the_tare_measures_the_noise_the_scene_declares() {
+        let scene = find("reference").expect("built in");
+        for (index, cell) in [scene.normal_cell, scene.tangential_cell]
+            .iter()
+            .enumerate()
+        {
+            for factor in [1.0, 4.0] {
+                let noisy = LoadCell {
+                    noise_rms_pct_fs: cell.noise_rms_pct_fs * factor,
+                    ..*cell
+                };
+                let mut channel = sensor_channel(&noisy).expect("channel");
+                commission(&mut channel, &noisy, COMMISSIONED, 7, index as u64)
+                    .expect("commissioned");
+                let measured = channel.noise().expect("tared").to_f64();
+                let declared = noisy.noise_rms_pct_fs / 100.0 * noisy.full_scale_n;
+                // 256 samples: the RMS of a burst is within 3 standard errors,
+                // 3 / sqrt(2 x 256) = 13 %, of the cell's (quantisation adds lsb^2 / 12).
+                assert!(
+                    (measured / declared - 1.0).abs() < 0.13,
+                    "cell {index} x{factor}: {measured} against {declared}"
+                );
+            }
         }
     }
 

@@ -263,3 +263,68 @@ fn unreachable_target_holds_full_drive_without_windup_and_recovers_cleanly() {
     assert!(overshoot <= 0.05, "overshoot {} %", overshoot * 100.0);
     assert!(last_outside <= 30, "settled after {last_outside} steps");
 }
+
+/// RMS of the PI's correction over the fast gains' hold after a step to half friction, on a
+/// plant with no model error (the correction is then the noise the loop passes), both cells
+/// at `noise_factor` times the acceptance's noise, with `settings` (the reference baseline
+/// tuned by the rule at some noise).
+fn correction_noise(settings: &Settings, noise_factor: f64, seed: u64) -> f64 {
+    let mut ctl = Controller::new(Config::new(settings).unwrap());
+    ctl.set_target(Target::Reduction { reduction_mpct: 0 })
+        .unwrap();
+    ctl.start().unwrap();
+    let model = LittmannModel::new(VA_MODEL);
+    let mut plant = Plant::new(MU, VA_MODEL, 0.8e-3, T, seed);
+    plant.normal_noise_n = noise_factor * 0.005 * 300.0;
+    plant.tangential_noise_n = noise_factor * 0.005 * 25.0;
+    let hold = (settings.boost_hold_s / T) as usize;
+    let mut corrections = Vec::new();
+    for k in 0..LEARN_STEPS + hold {
+        if k == LEARN_STEPS {
+            ctl.set_target(Target::Reduction {
+                reduction_mpct: 50_000,
+            })
+            .unwrap();
+        }
+        let out = ctl.step(&plant.measure(), &model);
+        plant.advance(out.amplitude);
+        if k >= LEARN_STEPS + 10 {
+            corrections.push(out.correction.to_f64());
+        }
+    }
+    let mean = corrections.iter().sum::<f64>() / corrections.len() as f64;
+    let square = corrections.iter().map(|c| (c - mean).powi(2)).sum::<f64>();
+    (square / corrections.len() as f64).sqrt()
+}
+
+/// The tuning rule leans on the model as the cells' noise grows: at ten times the acceptance's
+/// noise the Kalman gain of the fast phase falls below the sampled cap, and the loop tuned to
+/// the noise it measured passes less of it to the correction than the loop tuned to the
+/// acceptance's noise (same plant, same noise sequence).
+#[test]
+fn the_loop_tuned_to_its_noise_passes_less_of_it() {
+    let at = |factor: f64| Settings {
+        // The acceptance cells: 0.5 % of 300 N and of 25 N, at the 40 N load, mu 0.3.
+        normal_noise_n: factor * 0.005 * 300.0,
+        tangential_noise_n: factor * 0.005 * 25.0,
+        design_load_n: 40.0,
+        natural_prior: MU,
+        ..Settings::REFERENCE
+    };
+    let quiet = super::tuned(&at(1.0)).unwrap();
+    let noisy = super::tuned(&at(10.0)).unwrap();
+    assert!(
+        noisy.ki_fast_per_s < 0.7 * quiet.ki_fast_per_s,
+        "{} {}",
+        noisy.ki_fast_per_s,
+        quiet.ki_fast_per_s
+    );
+    for seed in 1..=3 {
+        let tuned_to_noise = correction_noise(&noisy, 10.0, seed);
+        let tuned_quiet = correction_noise(&quiet, 10.0, seed);
+        eprintln!(
+            "seed {seed}: correction RMS {tuned_to_noise:.4} (tuned to the noise), {tuned_quiet:.4} (not)"
+        );
+        assert!(tuned_to_noise < 0.9 * tuned_quiet, "seed {seed}");
+    }
+}

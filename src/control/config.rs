@@ -62,6 +62,10 @@ pub struct Settings {
     /// 0 for none. The prediction passes the same lag as the measurement
     /// (`tuning.rs` says why it is not lumped into the envelope).
     pub sensor_lag_s: f64,
+    /// Time constant of the contact's own friction transient, s: a Dahl contact's friction
+    /// relaxes over the slip length `mu W / k_t`, at the sliding speed in `mu W / (k_t v)`
+    /// (physics-notes; `tuning.rs`); 0 for a rigid contact. The prediction passes it first.
+    pub contact_lag_s: f64,
     /// Slew limit: time to change the command by full scale, s.
     pub slew_full_scale_s: f64,
     /// Soft start: time for the ceiling to rise by full scale, s.
@@ -76,12 +80,26 @@ pub struct Settings {
     pub kp: f64,
     /// Integral gain of the correction PI in steady state, 1/s.
     pub ki_per_s: f64,
-    /// Time constant of the fading from the fast to the steady gains, s.
-    pub boost_time_constant_s: f64,
+    /// How long the fast gains are held after the loop closes or the target changes, s
+    /// (then they fade to the steady ones by the running-mean law, `schedule.rs`).
+    pub boost_hold_s: f64,
     /// Bound of the PI's integral, ratio units.
     pub integral_limit: f64,
     /// The actuator's ratings, for the amplitude ceiling.
     pub actuator: ActuatorRatings,
+    /// RMS noise of one normal-force sample, N: measured by the cell's `tare`
+    /// (`sense::SensorChannel::noise`), the datasheet's until then. Only the tuning rule
+    /// ([`super::tuned`]) reads it.
+    pub normal_noise_n: f64,
+    /// RMS noise of one tangential-force sample, N (as `normal_noise_n`).
+    pub tangential_noise_n: f64,
+    /// The model's declared relative mismatch: the plant's friction reduction may differ from
+    /// the model's by this fraction (0.2: the acceptance's +-20 % in mu and k_t). Only the
+    /// tuning rule reads it.
+    pub model_mismatch: f64,
+    /// The load the noise is referred to, N: the lightest load the rig runs at (where the
+    /// cells' noise is largest against the forces). Only the tuning rule reads it.
+    pub design_load_n: f64,
 }
 
 impl Settings {
@@ -112,6 +130,7 @@ impl Settings {
         envelope_time_constant_s: 0.8e-3,
         response_time_constant_s: 0.25e-3,
         sensor_lag_s: 0.0,
+        contact_lag_s: 0.0,
         slew_full_scale_s: 0.5e-3,
         ramp_up_full_scale_s: 5e-3,
         ramp_down_full_scale_s: 5e-3,
@@ -119,9 +138,13 @@ impl Settings {
         ki_fast_per_s: 4_000.0,
         kp: 0.0,
         ki_per_s: 150.0,
-        boost_time_constant_s: 3e-3,
+        boost_hold_s: 3e-3,
         integral_limit: 0.5,
         actuator: ActuatorRatings::SEED_003_40_KHZ,
+        normal_noise_n: 0.05,
+        tangential_noise_n: 0.01,
+        model_mismatch: 0.2,
+        design_load_n: 4.0,
     };
 }
 
@@ -182,11 +205,28 @@ pub struct Config {
     pub(super) shaper: ShaperConfig,
     /// The tangential cell's lag, applied to the prediction; `None` without one.
     pub(super) sensor_lag: Option<LowPassCoef>,
+    /// The contact's relaxation lag, applied to the prediction; `None` without one.
+    pub(super) contact_lag: Option<LowPassCoef>,
     pub(super) ramp: RampConfig,
     pub(super) gains: GainSchedule,
     pub(super) limit: AmplitudeLimit,
     /// The ratings `limit` was computed from, kept for [`Config::at_drive_frequency`].
     pub(super) actuator: ActuatorRatings,
+}
+
+/// The PI's gain schedule of `settings`: the fast set held for `boost_hold_s`, fading to the
+/// steady set. Errors: `Gains` for unusable gains or hold, `OutOfRange` for the period.
+pub fn gain_schedule(settings: &Settings) -> Result<GainSchedule, ConfigError> {
+    let s = settings;
+    let period = positive(s.period_s, "period_s")?;
+    GainSchedule::new(
+        PiGains::new(s.kp_fast, s.ki_fast_per_s, period, s.integral_limit)
+            .map_err(ConfigError::Gains)?,
+        PiGains::new(s.kp, s.ki_per_s, period, s.integral_limit).map_err(ConfigError::Gains)?,
+        s.boost_hold_s,
+        period,
+    )
+    .map_err(ConfigError::Gains)
 }
 
 /// A positive finite value, or the error naming `setting`.
@@ -288,6 +328,15 @@ impl Config {
                 period,
             )
             .map_err(ConfigError::Shaper)?,
+            contact_lag: if s.contact_lag_s == 0.0 {
+                None
+            } else {
+                let lag = LowPassCoef::from_time_constant(s.contact_lag_s, period);
+                Some(lag.map_err(|error| ConfigError::Filter {
+                    setting: "contact_lag_s",
+                    error,
+                })?)
+            },
             sensor_lag: if s.sensor_lag_s == 0.0 {
                 None
             } else {
@@ -301,15 +350,7 @@ impl Config {
                 up_step: step(s.ramp_up_full_scale_s, "ramp_up_full_scale_s")?,
                 down_step: step(s.ramp_down_full_scale_s, "ramp_down_full_scale_s")?,
             },
-            gains: GainSchedule::new(
-                PiGains::new(s.kp_fast, s.ki_fast_per_s, period, s.integral_limit)
-                    .map_err(ConfigError::Gains)?,
-                PiGains::new(s.kp, s.ki_per_s, period, s.integral_limit)
-                    .map_err(ConfigError::Gains)?,
-                s.boost_time_constant_s,
-                period,
-            )
-            .map_err(ConfigError::Gains)?,
+            gains: gain_schedule(s)?,
             limit: AmplitudeLimit::new(&s.actuator).map_err(ConfigError::Limits)?,
             actuator: s.actuator,
         })

@@ -130,6 +130,8 @@ pub struct ControllerState {
     prediction: LowPass<30>,
     /// The prediction through the tangential cell's lag, before `prediction`'s filter.
     sensed_prediction: LowPass<30>,
+    /// The prediction through the contact's relaxation lag, before the cell's lag.
+    contact_prediction: LowPass<30>,
     prediction_valid: bool,
     /// The last model inversion's amplitude (Q1.31 fraction of full scale, [0, 1)): where
     /// the next inversion starts ([`FrictionModel::invert_from`]); zero from each ramp-up.
@@ -184,6 +186,7 @@ impl Controller {
                 gains: config.gains.slow(),
                 prediction: LowPass::new(Q2_30::ONE),
                 sensed_prediction: LowPass::new(Q2_30::ONE),
+                contact_prediction: LowPass::new(Q2_30::ONE),
                 prediction_valid: false,
                 feedforward: Q1_31::ZERO,
                 target: None,
@@ -353,8 +356,13 @@ impl Controller {
                 let seed = measured.saturating_add(s.pi.correction()).value;
                 s.prediction.reset(seed);
                 s.sensed_prediction.reset(seed);
+                s.contact_prediction.reset(seed);
                 s.prediction_valid = true;
             }
+            let predicted_now = match &c.contact_lag {
+                Some(lag) => s.contact_prediction.update(lag, predicted_now),
+                None => predicted_now,
+            };
             let sensed = match &c.sensor_lag {
                 Some(lag) => s.sensed_prediction.update(lag, predicted_now),
                 None => predicted_now,

@@ -80,13 +80,17 @@
 //! through (0.25 ms; the force filters' lag is in the prediction too); faster overcorrects,
 //! because the mismatch seen mid-transient belongs to another amplitude (with ±20 % mismatch
 //! `d` itself changes with `c` by a factor 0.8 to 1.25, the margin this leaves). That is the
-//! baseline; the scenes and boards run **ki 6000 /s** ([`FAST_GAINS`], `kiT` 0.6: poles 0.6 and
-//! -0.5), which learns the stiffest corner of the mismatch grid's model error before the
-//! feedforward's overshoot passes 5 %. **Slow gains `kp` 0.1, `ki` 300 /s**
-//! ([`STEADY_GAINS`]): poles 0.973 and -0.103, 3.6 ms, fast enough to follow a model error that
-//! moves with the operating point. The gains start fast when the loop closes or
-//! the target changes and fade to the slow set with **`tau_boost` = 3 ms** (the settling budget):
-//! the model error of a new operating point is found quickly, then averaged.
+//! baseline; the scenes and boards run the fast `ki` the tuning rule computes ([`tuned`]: the
+//! Kalman gain `m / (sigma_r sqrt(tau_L T))` of the observed model error against the cells'
+//! measured noise, capped at `ki T = 1 - m - kp` so that the correction's dominant pole stays
+//! non-negative for a declared mismatch `m`; 5000 /s for the reference). **Slow gains `kp`
+//! 0.1, `ki` 300 /s** ([`STEADY_GAINS`]): poles 0.973 and -0.103, 3.6 ms, fast enough to follow
+//! a model error that moves with the operating point. The gains start fast when the loop
+//! closes or the target changes, are held for three observation lags (`tau_L`, the envelope's
+//! response, the contact's relaxation, the cell and the force filter: [`observation_lag_s`])
+//! and then fade by the running-mean law `ki(t) = 1 / (t + 1 / ki_fast)` to the slow set
+//! (`schedule.rs`): the model error of a new operating point is found quickly, then averaged.
+//! The derivation: docs/control-and-scenes.md, "Tuning from the rig's physics".
 //!
 //! # Drive shaping and limits (shaper.rs, limits.rs)
 //!
@@ -140,7 +144,7 @@ mod property_tests;
 #[cfg(test)]
 mod testkit;
 
-pub use config::{Config, ConfigError, SensorRanges, Settings};
+pub use config::{Config, ConfigError, SensorRanges, Settings, gain_schedule};
 pub use controller::{Controller, ControllerState};
 pub use error::ControlError;
 pub use estimate::{
@@ -160,6 +164,8 @@ pub use sliding::{SlidingConfig, SlidingDetector};
 pub use supervisor::{Contact, RampConfig, Supervisor};
 pub use target::{ForceQ, PreparedTarget};
 pub use tuning::{
-    FAST_GAINS, FORCE_FILTER_HZ, NATURAL_LEARN_S, NATURAL_PRIOR_WEIGHT, SLIDING_DEBOUNCE_S,
-    STEADY_GAINS, VELOCITY_FILTER_HZ, controller_settings,
+    DECLARED_MODEL_MISMATCH, FORCE_FILTER_HZ, HOLD_LAG_MULTIPLE, NATURAL_LEARN_S,
+    NATURAL_PRIOR_WEIGHT, SLIDING_DEBOUNCE_S, STEADY_GAINS, VELOCITY_FILTER_HZ, contact_lag_s,
+    controller_settings, noise_limited_ki_per_s, noise_rms_error, observation_lag_s, ratio_noise,
+    sampled_ki_cap_per_s, tuned,
 };

@@ -5,10 +5,18 @@
 //! +-20 % model mismatch), but once found it changes only as slowly as the load and the
 //! surfaces do. A PI fast enough for the first task passes the load cells' noise through to
 //! the friction at several hundred hertz. So the gains start at the `fast` set when the loop
-//! closes or the target changes, and relax to the `slow` set exponentially with a time
-//! constant `tau_boost`: `g = slow + (fast - slow) w`, `w <- w exp(-T / tau_boost)`, the way a
-//! Kalman filter's gain falls after its covariance is reset. The gains change a little every
-//! step; [`super::pi::Pi::retune`] keeps each change bumpless.
+//! closes or the target changes, and relax to the `slow` set as a scalar Kalman filter's gain
+//! does after its covariance is reset: `g = slow + (fast - slow) w`. While the drive's
+//! transient lasts (`hold`, about three time constants of the lag chain the model error is
+//! seen through: `control/tuning.rs`) the model error the cells show is still moving, the
+//! filter's process noise is large and its gain stays at the fast value (`w = 1`). Once the
+//! error it observes is constant, the Riccati equation without process noise, `P' = -P^2 /
+//! r`, makes the gain `K = P / r` fall as `1 / (t + 1 / K_fast)`: the running mean of what
+//! has been seen since. In weight terms `w' = -K_fast w^2`, one step `w <- w - (K_fast T) w^2`
+//! (one multiply; `K_fast T` is the fast set's `ki T`). The fade is independent of the noise
+//! (the running mean is the best estimate of a constant whatever the noise); the noise sets
+//! `K_fast` and the `slow` floor. The gains change a little every step;
+//! [`super::pi::Pi::retune`] keeps each change bumpless.
 
 use super::pi::{GainsError, PiGains};
 use crate::fx::Q2_30;
@@ -19,26 +27,31 @@ use crate::fx::Q2_30;
 pub struct GainSchedule {
     fast: PiGains,
     slow: PiGains,
-    decay: Q2_30,
+    /// Steps the fast gains are held after a restart.
+    hold_steps: u32,
+    /// Shrink of the weight per step, `K_fast T` (the fast `ki T`), Q2.30 in [0, 1].
+    shrink: Q2_30,
 }
 
 impl GainSchedule {
-    /// `fast` gains fading into `slow` ones with time constant `boost_time_constant_s` at
-    /// the control period `period_s`. Error `NotFinite` unless both times are positive.
+    /// `fast` gains held for `hold_s` after a restart, then fading into `slow` ones by the
+    /// running-mean law (module docs) at the control period `period_s`. Error `NotFinite`
+    /// unless the hold is finite and non-negative and the period positive.
     pub fn new(
         fast: PiGains,
         slow: PiGains,
-        boost_time_constant_s: f64,
+        hold_s: f64,
         period_s: f64,
     ) -> Result<Self, GainsError> {
-        if !(boost_time_constant_s > 0.0 && period_s > 0.0 && period_s.is_finite()) {
+        if !(hold_s >= 0.0 && hold_s.is_finite() && period_s > 0.0 && period_s.is_finite()) {
             return Err(GainsError::NotFinite);
         }
-        let decay = libm::exp(-period_s / boost_time_constant_s);
+        let hold_steps = libm::round(hold_s / period_s).min(u32::MAX as f64) as u32;
         Ok(Self {
             fast,
             slow,
-            decay: Q2_30::from_f64(decay).map_err(|_| GainsError::OutOfRange)?,
+            hold_steps,
+            shrink: fast.ki_step(),
         })
     }
 
@@ -47,7 +60,8 @@ impl GainSchedule {
         Self {
             fast: gains,
             slow: gains,
-            decay: Q2_30::ZERO,
+            hold_steps: 0,
+            shrink: Q2_30::ONE,
         }
     }
 
@@ -66,17 +80,25 @@ impl GainSchedule {
         self.slow
     }
 
-    /// Factor of the boost weight per step, `exp(-T / tau_boost)`, Q2.30 in [0, 1).
-    pub const fn decay(&self) -> Q2_30 {
-        self.decay
+    /// Steps the fast gains are held after a restart.
+    pub const fn hold_steps(&self) -> u32 {
+        self.hold_steps
+    }
+
+    /// Shrink of the weight per step after the hold, `K_fast T`, Q2.30 in [0, 1].
+    pub const fn shrink(&self) -> Q2_30 {
+        self.shrink
     }
 }
 
-/// The boost weight, state: 1 after [`Boost::restart`], fading by the schedule's decay.
+/// The boost weight, state: 1 after [`Boost::restart`], held, then fading by the schedule's
+/// running-mean law.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Boost {
     weight: Q2_30,
+    /// Steps held since the restart (up to the schedule's hold).
+    held: u32,
 }
 
 impl Boost {
@@ -84,20 +106,29 @@ impl Boost {
     pub const fn new() -> Self {
         Self {
             weight: Q2_30::ZERO,
+            held: 0,
         }
     }
 
     /// Full boost (the operating point was just set).
     pub fn restart(&mut self) {
         self.weight = Q2_30::ONE;
+        self.held = 0;
     }
 
-    /// One step of fading. Rounded down, so that the weight reaches exactly zero (rounding
-    /// to nearest would stop it at the few ulps where `w decay` rounds back to `w`).
+    /// One step: held, then `w <- w - (K_fast T) w^2`. The decrement is rounded up (at least
+    /// one lsb while `w > 0`), so that the weight reaches exactly zero (rounding to nearest
+    /// would stop it where `s w^2` rounds to nothing).
     pub fn advance(&mut self, schedule: &GainSchedule) {
-        // Both in [0, 2^30]: the product fits i64 and the result [0, 2^30].
-        let product = self.weight.to_bits() as i64 * schedule.decay.to_bits() as i64;
-        self.weight = Q2_30::from_bits((product >> 30) as i32);
+        if self.held < schedule.hold_steps {
+            self.held += 1;
+            return;
+        }
+        // w and s in [0, 2^30]: w^2 < 2^61 and (w^2 >> 30) s < 2^61, both fit i64.
+        let w = self.weight.to_bits() as i64;
+        let square = (w * w + (1 << 30) - 1) >> 30;
+        let decrement = (square * schedule.shrink.to_bits() as i64 + (1 << 30) - 1) >> 30;
+        self.weight = Q2_30::from_bits((w - decrement.max(i64::from(w > 0))).max(0) as i32);
     }
 
     /// The weight, Q2.30 in [0, 1].
@@ -114,26 +145,39 @@ mod tests {
     fn boost_fades_from_fast_to_slow() {
         let fast = PiGains::new(0.3, 3_000.0, 1e-4, 0.5).unwrap();
         let slow = PiGains::new(0.0, 500.0, 1e-4, 0.5).unwrap();
-        let schedule = GainSchedule::new(fast, slow, 3e-3, 1e-4).unwrap();
+        // Held for 1 ms (10 steps), then the running mean from ki 3000 /s.
+        let schedule = GainSchedule::new(fast, slow, 1e-3, 1e-4).unwrap();
         let mut boost = Boost::new();
         assert_eq!(schedule.gains(boost.weight()), slow);
         boost.restart();
-        assert_eq!(schedule.gains(boost.weight()), fast);
-        for _ in 0..30 {
+        for _ in 0..10 {
+            assert_eq!(schedule.gains(boost.weight()), fast);
             boost.advance(&schedule);
         }
-        // After one time constant: slow + (fast - slow) / e.
+        assert_eq!(schedule.gains(boost.weight()), fast);
+        for _ in 0..100 {
+            boost.advance(&schedule);
+        }
+        // 10 ms after the hold: w = 1 / (1 + K_fast t) = 1 / 31 by the continuous law; the
+        // one-step recurrence of w' = -K w^2 with K T = 0.3 runs a little slower (it sums
+        // 1/w in steps of K T / (1 - K T w)): within 5 %.
+        let w = boost.weight().to_f64();
+        assert!((w * 31.0 - 1.0).abs() < 0.05, "{w}");
         let g = schedule.gains(boost.weight());
-        let want = 0.05 + 0.25 * (-1.0f64).exp();
-        assert!((g.ki_step().to_f64() - want).abs() < 1e-6, "{g:?}");
-        assert!((g.kp().to_f64() - 0.3 * (-1.0f64).exp()).abs() < 1e-6);
-        for _ in 0..10_000 {
+        assert!(
+            (g.ki_step().to_f64() - (0.05 + 0.25 * w)).abs() < 1e-6,
+            "{g:?}"
+        );
+        // The hyperbola reaches 2^-15 after about 1 / (K T 2^-15) = 110 000 steps, then one lsb
+        // a step to zero.
+        for _ in 0..200_000 {
             boost.advance(&schedule);
         }
         assert_eq!(boost.weight(), Q2_30::ZERO);
         assert_eq!(schedule.gains(boost.weight()), slow);
         let constant = GainSchedule::constant(fast);
         assert_eq!(constant.gains(Q2_30::ONE), constant.gains(Q2_30::ZERO));
-        assert!(GainSchedule::new(fast, slow, 0.0, 1e-4).is_err());
+        assert!(GainSchedule::new(fast, slow, -1.0, 1e-4).is_err());
+        assert!(GainSchedule::new(fast, slow, f64::NAN, 1e-4).is_err());
     }
 }

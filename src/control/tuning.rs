@@ -6,7 +6,7 @@
 //! runs the tuning the scene runs were judged with. The departures were found on the scene runs
 //! (`sonolube scene --all`, 12 noise seeds), each with a physical reason.
 
-use super::config::Settings;
+use super::config::{ConfigError, Settings};
 use super::limits::ActuatorRatings;
 use crate::scene::{LoadCell, Scene};
 
@@ -77,25 +77,127 @@ pub const NATURAL_LEARN_S: f64 = 3e-3;
 /// reference scene's steady RMS error goes from 0.68 % to 0.69 %.
 pub const STEADY_GAINS: (f64, f64) = (0.1, 300.0);
 
-/// Fast PI gains (the set the boost starts from at a start or a target change):
-/// proportional (ratio per ratio) and integral (1/s).
-///
-/// The baseline's kp 0.3, ki 4000 /s (`kiT` 0.4, poles 0.72 and -0.42) left the mismatch
-/// grid's stiffest, highest-friction corner (plant mu x1.3 and k_t x2 of the controller's:
-/// the plant reduces the friction more at a given amplitude than the model says) to the
-/// feedforward's own overshoot for too long: 5.04-5.28 % of the step (limit 5 %) at 6 of 81
-/// points, with the drive pinned or following the resonance. The overshoot shrinks as the
-/// integral learns that model error sooner (ki 3000, 4000, 5000, 6000 /s: worst 5.6, 5.3,
-/// 5.0, 4.8 %); at ki 6000 /s (`kiT` 0.6: poles 0.6 and -0.5, a 0.2 ms time constant, still
-/// well inside the unit circle) every grid point passes on the scene's seed and the seed
-/// sweep of every scene is unchanged in its verdicts (1,300 of 1,300). The steady gains
-/// take over within the boost's 3 ms, so the steady RMS error does not see the faster set.
-pub const FAST_GAINS: (f64, f64) = (0.3, 6_000.0);
+/// The model's mismatch the tuning assumes when the user declares none: the plant's friction
+/// reduction may differ from the model's by +-20 % (the acceptance scene's mu x1.2 and k_t
+/// x0.8, and the mismatch grid's range).
+pub const DECLARED_MODEL_MISMATCH: f64 = 0.2;
+
+/// The time constant of a compliant contact's friction transient, s: a Dahl contact (alpha 1,
+/// seed 003 eqs 5-7) relaxes its friction over the slip length `mu W / k_t`, covered at the
+/// sliding speed in `mu W / (k_t v)`. From the controller's model (its `mu` and `k_t`) at the
+/// load and speed `load_n`, `speed_m_per_s`; 0 for a rigid contact (no `k_t`) or no sliding.
+/// `compliant` (mu 0.2, W 4.155 N, k_t 0.056 N/um, 0.038 m/s): 0.39 ms, as slow as the
+/// envelope; the reference's Mindlin k_t (25 N/um): 0.9 us.
+pub fn contact_lag_s(mu: f64, k_t_n_per_m: Option<f64>, load_n: f64, speed_m_per_s: f64) -> f64 {
+    match k_t_n_per_m {
+        Some(k_t) if k_t > 0.0 && load_n > 0.0 && speed_m_per_s > 0.0 => {
+            mu * load_n / (k_t * speed_m_per_s)
+        }
+        _ => 0.0,
+    }
+}
+
+/// How long the fast gains are held, in observation lags ([`observation_lag_s`]): the observed
+/// model error rises with the lag chain's step response, so the hold lasts until it is within
+/// about e^-3 (5 %) of its new value; after that it is constant and the gain falls by the
+/// running-mean law (`schedule.rs`).
+pub const HOLD_LAG_MULTIPLE: f64 = 3.0;
+
+/// The lag chain the PI sees the model error through, s: the drive's envelope with the lead
+/// (`response_time_constant_s`), the contact's relaxation ([`contact_lag_s`]), the tangential
+/// cell's lag and the force filter. The
+/// prediction passes the same stages, so the chain delays the model error, not the loop.
+pub fn observation_lag_s(s: &Settings) -> f64 {
+    s.response_time_constant_s
+        + s.contact_lag_s
+        + s.sensor_lag_s
+        + 1.0 / (core::f64::consts::TAU * s.tangential_bandwidth_hz)
+}
+
+/// RMS noise of one sample of the measured friction ratio `F_t / (mu0 F_n)` at the design
+/// load, ratio units: the tangential cell's noise against the natural friction force `mu0 W`
+/// and the normal cell's against `W`, independent, so their squares add.
+pub fn ratio_noise(s: &Settings) -> f64 {
+    let load = s.design_load_n;
+    let friction = s.natural_prior * load;
+    libm::sqrt(
+        libm::pow(s.tangential_noise_n / friction, 2.0) + libm::pow(s.normal_noise_n / load, 2.0),
+    )
+}
+
+/// The steady RMS error of the friction the cells' noise predicts, as a fraction of the
+/// target: a reduction or ratio target is relative to mu0, learned as the mean of the samples
+/// taken sliding with the drive off for `learn_s` before the target changes. Its standard error,
+/// `sigma_r / sqrt(n)` ([`ratio_noise`] at the design load, `n = learn_s / T` samples: the
+/// force filter has unit gain at DC, so averaging its output over many time constants keeps
+/// the variance of the raw mean), is a steady error of the held friction no feedback sees.
+/// Returns `None` when no sample is learned (`learn_s < T`).
+pub fn noise_rms_error(s: &Settings, learn_s: f64) -> Option<f64> {
+    let samples = libm::floor(learn_s / s.period_s);
+    (samples >= 1.0).then(|| ratio_noise(s) / libm::sqrt(samples))
+}
+
+/// The fast integral gain the noise allows, 1/s: the steady gain of a Kalman-Bucy filter of
+/// the observed model error while the drive's transient moves it, `K = sqrt(q / r)`. The
+/// error is of size `m` (the declared mismatch, ratio units over the model's range) and moves
+/// over one observation lag `tau_L`: process noise density `q = m^2 / tau_L`. One sample of
+/// the ratio has noise `sigma_r` ([`ratio_noise`]) each period `T`: measurement noise density
+/// `r = sigma_r^2 T`. So `K = m / (sigma_r sqrt(tau_L T))`: the gain falls as the noise grows
+/// (the loop leans on the model) and rises with the mismatch (it leans on the cells).
+pub fn noise_limited_ki_per_s(s: &Settings) -> f64 {
+    let sigma = ratio_noise(s);
+    s.model_mismatch / (sigma * libm::sqrt(observation_lag_s(s) * s.period_s))
+}
+
+/// The fast integral gain the sampled loop allows, 1/s. For a static model error whose size
+/// grows with the correction by up to `g = 1 / (1 - m)` (a plant that reduces the friction `m`
+/// more than the model says), the correction's dominant pole is `1 - g (kp + ki T)` ("Tuning by
+/// pole placement" in [`crate::control`]); it stays at or above zero, so that the correction
+/// never alternates, for `ki T <= 1 / g - kp = 1 - m - kp`.
+pub fn sampled_ki_cap_per_s(s: &Settings) -> f64 {
+    libm::fmax(1.0 - s.model_mismatch - s.kp_fast, 0.0) / s.period_s
+}
+
+/// `settings` with the fast integral gain and the hold computed by the design rule from the
+/// rig's parameters in it (the control period, the lag chain [`observation_lag_s`], the
+/// cells' noise [`ratio_noise`] and the declared mismatch): `ki_fast` the smaller of
+/// [`noise_limited_ki_per_s`] and [`sampled_ki_cap_per_s`], the hold [`HOLD_LAG_MULTIPLE`]
+/// observation lags. The steady gains and the fast `kp` are kept. The station calls it again
+/// with the noise its `tare` measured. Errors: a mismatch outside [0, 1), a negative or
+/// non-finite noise or a non-positive design load or prior (`OutOfRange` naming the setting).
+pub fn tuned(settings: &Settings) -> Result<Settings, ConfigError> {
+    let s = settings;
+    let bad = |setting| Err(ConfigError::OutOfRange { setting });
+    if !(s.model_mismatch >= 0.0 && s.model_mismatch < 1.0) {
+        return bad("model_mismatch");
+    }
+    for (value, setting) in [
+        (s.normal_noise_n, "normal_noise_n"),
+        (s.tangential_noise_n, "tangential_noise_n"),
+    ] {
+        if !(value >= 0.0 && value.is_finite()) {
+            return bad(setting);
+        }
+    }
+    if !(s.design_load_n > 0.0 && s.design_load_n.is_finite()) {
+        return bad("design_load_n");
+    }
+    if !(s.natural_prior > 0.0 && s.period_s > 0.0 && s.tangential_bandwidth_hz > 0.0) {
+        return bad("natural_prior");
+    }
+    // A noise-free cell allows any gain: the sampled cap binds (min of x and +inf is x).
+    let ki_fast = libm::fmin(sampled_ki_cap_per_s(s), noise_limited_ki_per_s(s));
+    Ok(Settings {
+        ki_fast_per_s: ki_fast,
+        boost_hold_s: HOLD_LAG_MULTIPLE * observation_lag_s(s),
+        ..*s
+    })
+}
 
 /// The controller's settings for `scene`: [`Settings::REFERENCE`] with the tuning's
 /// departures ([`FORCE_FILTER_HZ`] for both force filters, [`VELOCITY_FILTER_HZ`],
 /// [`NATURAL_PRIOR_WEIGHT`], [`SLIDING_DEBOUNCE_S`], [`NATURAL_LEARN_S`], [`STEADY_GAINS`],
-/// [`FAST_GAINS`]) and
+/// and the fast integral gain and hold of the design rule [`tuned`]) and
 /// what the scene fixes: the control period, the actuator ratings at the drive frequency, the
 /// controller's natural coefficient as the prior of mu0, plausible ranges of the readings
 /// (1.1 x each cell's full scale, twice the fastest sliding speed but at least 5 m/s), the
@@ -134,8 +236,8 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
     let cell_lag_s = 1.0 / (core::f64::consts::TAU * scene.tangential_cell.bandwidth_hz);
     let envelope = scene.transducer.envelope_time_constant_s();
     let (kp, ki_per_s) = STEADY_GAINS;
-    let (kp_fast, ki_fast_per_s) = FAST_GAINS;
-    Settings {
+    let declared_noise = |cell: &LoadCell| cell.noise_rms_pct_fs / 100.0 * cell.full_scale_n;
+    let settings = Settings {
         period_s: scene.control_period_s(),
         normal_bandwidth_hz: FORCE_FILTER_HZ,
         tangential_bandwidth_hz: FORCE_FILTER_HZ,
@@ -160,12 +262,19 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
         natural_prior_weight: NATURAL_PRIOR_WEIGHT,
         envelope_time_constant_s: envelope,
         sensor_lag_s: cell_lag_s,
+        // The slowest contact the declared mismatch allows (k_t down to (1 - m) of the
+        // model's): a prediction faster than the plant reads as a plant short of reduction and
+        // the fast integral overdrives into overshoot; a slower one only delays its learning.
+        contact_lag_s: contact_lag_s(
+            scene.controller.natural_coefficient(start_speed),
+            scene.controller.k_t_n_per_m,
+            scene.normal_load_n.first().map_or(0.0, |p| p.value),
+            start_speed,
+        ) / (1.0 - DECLARED_MODEL_MISMATCH),
         // The lead cannot make the envelope slower than it is.
         response_time_constant_s: libm::fmin(reference.response_time_constant_s, envelope),
         kp,
         ki_per_s,
-        kp_fast,
-        ki_fast_per_s,
         actuator: ActuatorRatings {
             max_voltage_v: scene.actuator.max_voltage_v,
             max_current_a: scene.actuator.max_current_a,
@@ -173,14 +282,73 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
             drive_frequency_hz: scene.transducer.drive_hz,
             full_scale_voltage_v: scene.actuator.full_scale_voltage_v,
         },
+        // The datasheet's noise until a tare measures it (`Station::tune_to_cells`).
+        normal_noise_n: declared_noise(&scene.normal_cell),
+        tangential_noise_n: declared_noise(&scene.tangential_cell),
+        model_mismatch: DECLARED_MODEL_MISMATCH,
+        design_load_n: scene.contents.load_min_n,
         ..reference
-    }
+    };
+    // The scene schema bounds the noise to [0, 10] % FS and the loads to positive values,
+    // and the mismatch is the constant above: the rule accepts them.
+    tuned(&settings).unwrap_or(settings)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::scene::find;
+
+    #[test]
+    fn the_predicted_error_grows_with_the_noise_and_falls_with_the_learning() {
+        let s = controller_settings(find("reference").expect("built in"));
+        // sigma_r = sqrt((0.01 / (0.2 x 4.155))^2 + (0.05 / 4.155)^2) = 1.70 %; 40 samples.
+        let e = noise_rms_error(&s, 4e-3).expect("learned");
+        assert!((e - 0.017_02 / 40f64.sqrt()).abs() < 1e-5, "{e}");
+        let noisy = Settings {
+            tangential_noise_n: 0.02,
+            normal_noise_n: 0.1,
+            ..s
+        };
+        assert!((noise_rms_error(&noisy, 4e-3).expect("learned") / e - 2.0).abs() < 1e-9);
+        assert!((e / noise_rms_error(&s, 16e-3).expect("learned") - 2.0).abs() < 1e-9);
+        assert_eq!(noise_rms_error(&s, 0.5e-4), None);
+    }
+
+    #[test]
+    fn the_fast_gain_follows_the_noise_and_the_mismatch() {
+        let base = controller_settings(find("reference").expect("built in"));
+        let at = |noise_factor: f64, mismatch: f64| {
+            let s = Settings {
+                normal_noise_n: base.normal_noise_n * noise_factor,
+                tangential_noise_n: base.tangential_noise_n * noise_factor,
+                model_mismatch: mismatch,
+                ..base
+            };
+            tuned(&s).expect("valid").ki_fast_per_s
+        };
+        // The reference's noise leaves the sampled cap binding; 20 and 40 times the noise
+        // bring the Kalman gain below it, halving with each doubling of the noise.
+        assert_eq!(at(1.0, 0.2), at(2.0, 0.2));
+        let (k20, k40) = (at(20.0, 0.2), at(40.0, 0.2));
+        assert!(k20 < at(1.0, 0.2), "{k20}");
+        assert!((k20 / k40 - 2.0).abs() < 1e-9, "{k20} {k40}");
+        // A larger declared mismatch leans on the cells: a higher noise-limited gain.
+        assert!(at(40.0, 0.3) > k40);
+        // And a smaller cap: the mismatch's growth with the correction limits kiT.
+        assert!(at(1.0, 0.4) < at(1.0, 0.2));
+        // Refused: a mismatch of 100 %, a negative noise.
+        let bad = Settings {
+            model_mismatch: 1.0,
+            ..base
+        };
+        assert!(tuned(&bad).is_err());
+        let bad = Settings {
+            tangential_noise_n: -1.0,
+            ..base
+        };
+        assert!(tuned(&bad).is_err());
+    }
 
     #[test]
     fn the_reference_scene_fixes_its_numbers_and_keeps_the_tuning() {
@@ -210,11 +378,35 @@ mod tests {
         assert_eq!((s.kp, s.ki_per_s), STEADY_GAINS);
         assert_eq!(s.natural_prior_weight, NATURAL_PRIOR_WEIGHT);
         assert_eq!(s.sliding_debounce_s, SLIDING_DEBOUNCE_S);
-        assert_eq!(
-            (s.kp_fast, s.ki_fast_per_s, s.boost_time_constant_s),
-            (0.3, 6_000.0, 3e-3)
+        // The rule: kiT capped at 1 - 0.2 - 0.3 = 0.5 (the noise allows 38 000 /s), held for
+        // three lags of 0.25 ms + 79.6 us + 0.637 ms.
+        assert_eq!(s.kp_fast, 0.3);
+        assert!(
+            (s.ki_fast_per_s - 5_000.0).abs() < 1e-6,
+            "{}",
+            s.ki_fast_per_s
         );
-        assert_eq!((s.kp_fast, s.ki_fast_per_s), FAST_GAINS);
+        // (three lags: 0.25 ms + 1.09 us of contact, 0.2 x 4.155 N / (0.8 x 25 N/um x
+        // 0.038 m/s), + 79.6 us + 0.637 ms.)
+        assert!(
+            (s.contact_lag_s - 1.093_6e-6).abs() < 1e-9,
+            "{}",
+            s.contact_lag_s
+        );
+        assert!(
+            (s.boost_hold_s - 3.0 * 0.967_3e-3).abs() < 1e-6,
+            "{}",
+            s.boost_hold_s
+        );
+        // The compliant contact's own k_t (0.056 N/um): 0.39 ms, 0.49 ms at 0.8 k_t, in the
+        // chain.
+        let compliant = controller_settings(find("compliant").expect("built in"));
+        assert!(
+            (compliant.contact_lag_s - 0.488_1e-3).abs() < 1e-6,
+            "{}",
+            compliant.contact_lag_s
+        );
+        assert!((observation_lag_s(&compliant) - observation_lag_s(&s) - 0.487_0e-3).abs() < 1e-6);
         assert!((s.tangential_force_range_n - 2.2).abs() < 1e-12);
         assert_eq!(s.velocity_range_m_s, 5.0);
         assert!(crate::control::Config::new(&s).is_ok());

@@ -129,9 +129,48 @@ pub fn mean(readings: impl IntoIterator<Item = Q1_31>) -> Option<Q1_31> {
         .map(Q1_31::from_bits)
 }
 
+/// The RMS deviation of `readings` from `mean` (their standard deviation, population form),
+/// rounded down: the noise of a burst taken with the load steady (the tare). Q1.31 fraction of
+/// full scale in [0, 2^31); `None` for no readings. Sums the squared deviations in `u128`
+/// (each < 2^64: exact for any burst that fits memory); the square root is the integer one,
+/// exact to the lsb. Configuration-time arithmetic (one square root per tare).
+pub fn rms_deviation(readings: impl IntoIterator<Item = Q1_31>, mean: Q1_31) -> Option<Q1_31> {
+    let mut sum: u128 = 0;
+    let mut count: u128 = 0;
+    for reading in readings {
+        let deviation = i64::from(reading.to_bits()) - i64::from(mean.to_bits());
+        sum = sum.saturating_add(u128::from(deviation.unsigned_abs().pow(2)));
+        count += 1;
+    }
+    if count == 0 {
+        return None;
+    }
+    let variance = sum / count;
+    // Deviations are below 2^32, so the variance is below 2^64 and its root below 2^32.
+    let root = u64::try_from(variance).map_or(u64::MAX, |v| v.isqrt());
+    i32::try_from(root)
+        .ok()
+        .map(Q1_31::from_bits)
+        .or(Some(Q1_31::MAX))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rms_deviation_of_a_burst() {
+        let q = |bits: i32| Q1_31::from_bits(bits);
+        // Deviations -3, +3, -3, +3 lsb about 10: RMS 3.
+        let burst = [q(7), q(13), q(7), q(13)];
+        assert_eq!(rms_deviation(burst, q(10)), Some(q(3)));
+        assert_eq!(rms_deviation([q(5); 8], q(5)), Some(Q1_31::ZERO));
+        assert_eq!(rms_deviation([], q(0)), None);
+        // The extremes: half the readings at each end of the range, about the middle.
+        let wide = [Q1_31::MIN, Q1_31::MAX, Q1_31::MIN, Q1_31::MAX];
+        let rms = rms_deviation(wide, Q1_31::ZERO).unwrap().to_f64();
+        assert!((rms - 1.0).abs() < 1e-9, "{rms}");
+    }
 
     fn q31(x: f64) -> Q1_31 {
         Q1_31::from_f64(x).unwrap()

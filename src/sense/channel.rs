@@ -1,6 +1,6 @@
 //! One sensor channel from raw code to physical value: format, fault checks, calibration.
 
-use super::calibration::{Calibration, mean};
+use super::calibration::{Calibration, mean, rms_deviation};
 use super::error::SenseError;
 use super::fault::{FaultLimits, FaultMonitor, SensorFault};
 use super::format::AdcFormat;
@@ -24,6 +24,9 @@ pub struct SensorChannel {
     format: AdcFormat,
     calibration: Calibration,
     monitor: FaultMonitor,
+    /// The RMS noise of the last tare's burst, Q1.31 fraction of full scale (its standard
+    /// deviation about its mean); `None` before a tare.
+    noise: Option<Q1_31>,
 }
 
 impl SensorChannel {
@@ -34,6 +37,7 @@ impl SensorChannel {
             format,
             calibration,
             monitor: FaultMonitor::new(format, limits),
+            noise: None,
         }
     }
 
@@ -45,13 +49,31 @@ impl SensorChannel {
         Ok(self.calibration.apply(reading))
     }
 
-    /// Sets the zero to the mean of `codes` taken with no load (or with the drive off).
-    /// Errors: `InvalidFormat` for no codes, `CodeOutOfRange` for a code the converter cannot
-    /// produce.
+    /// Sets the zero to the mean of `codes` taken with no load (or with the drive off), and
+    /// measures the cell's noise as the burst's RMS deviation from that mean (the load is
+    /// steady, so what moves is the cell's and the converter's noise, quantisation included):
+    /// [`Self::noise`]. Errors: `InvalidFormat` for no codes, `CodeOutOfRange` for a code the
+    /// converter cannot produce.
     pub fn tare(&mut self, codes: &[i32]) -> Result<(), SenseError> {
         let zero = self.mean_reading(codes)?;
+        let readings = codes
+            .iter()
+            .filter_map(|&code| self.format.normalize(code).ok());
+        self.noise = rms_deviation(readings, zero);
         self.calibration = self.calibration.with_tare(zero);
         Ok(())
+    }
+
+    /// The noise the last tare measured, RMS per sample, in the channel's unit (Q16.16
+    /// newtons): the burst's RMS deviation times the span, rounded up by one lsb so that a
+    /// noisy cell never reads as noise-free; saturating at the Q16.16 maximum. `None` before a
+    /// tare. The controller's tuning takes it (`control::Settings::tangential_noise_n`).
+    pub fn noise(&self) -> Option<Q16_16> {
+        let noise = self.noise?;
+        let span = i64::from(self.calibration.span().to_bits()).unsigned_abs();
+        // noise < 2^31 and span <= 2^31: the product < 2^62; >> 31 gives Q16.16.
+        let value = ((u64::from(noise.to_bits().unsigned_abs()) * span) >> 31) + 1;
+        Some(i32::try_from(value).map_or(Q16_16::MAX, Q16_16::from_bits))
     }
 
     /// Sets the span so that the mean of `codes`, taken under `load` (Q16.16 newtons), reads
@@ -125,6 +147,25 @@ mod tests {
         assert!((value.value.to_f64() - 20.0).abs() < 1e-3);
         let half = cell.process(33_656).unwrap().value.to_f64();
         assert!((half - 10.0).abs() < 0.02, "{half}");
+    }
+
+    #[test]
+    fn the_tare_measures_the_cells_noise() {
+        let mut cell = channel();
+        assert_eq!(cell.noise(), None);
+        // +-8 codes of the 16-bit result about 33 000: 8 / 65 536 of full scale, 500 N per full
+        // scale: 0.061 N RMS.
+        let burst: [i32; 64] = core::array::from_fn(|k| if k % 2 == 0 { 32_992 } else { 33_008 });
+        cell.tare(&burst).unwrap();
+        let noise = cell.noise().unwrap().to_f64();
+        assert!((noise - 500.0 * 8.0 / 65_536.0).abs() < 1e-4, "{noise}");
+        // A quiet burst reads one lsb, not zero; a burst four times as noisy, four times.
+        cell.tare(&[33_000; 16]).unwrap();
+        assert_eq!(cell.noise(), Some(Q16_16::from_bits(1)));
+        let loud: [i32; 64] = core::array::from_fn(|k| if k % 2 == 0 { 32_968 } else { 33_032 });
+        cell.tare(&loud).unwrap();
+        let ratio = cell.noise().unwrap().to_f64() / noise;
+        assert!((ratio - 4.0).abs() < 1e-3, "{ratio}");
     }
 
     #[test]

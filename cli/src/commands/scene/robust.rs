@@ -570,6 +570,7 @@ fn envelope(scene: &Scene<'_>, seeds: &[u64], jobs: usize, out: &Path) -> Result
     for line in failures(&runs, &results) {
         println!("  FAIL {line}");
     }
+    noise_prediction(scene, &points, &loaded, seeds.len(), &results);
     // What limits the misses: the same runs with both cells' noise at zero, and with cells a
     // user would size to the load (same noise in % FS).
     rerun(
@@ -590,6 +591,68 @@ fn envelope(scene: &Scene<'_>, seeds: &[u64], jobs: usize, out: &Path) -> Result
         ),
     );
     Ok(Done { stats, results })
+}
+
+/// Below 1 N the cells' noise, not the physics, limits the steady error: for each such load
+/// the RMS error the noise predicts ([`sonolube::control::noise_rms_error`]: mu0's standard
+/// error after its learning, from the point's tuning and cells) beside the measured RMS error
+/// (mean and worst of the load's runs).
+fn noise_prediction(
+    scene: &Scene<'_>,
+    points: &[super::grid::EnvelopePoint],
+    loaded: &[crate::scene_file::LoadedScene],
+    seeds: usize,
+    results: &[Result<RunSummary, String>],
+) {
+    let Some(rms_index) = scene
+        .criteria
+        .iter()
+        .position(|c| matches!(c, sonolube::scene::Criterion::SteadyRmsError { .. }))
+    else {
+        return;
+    };
+    println!(
+        "  below 1 N, RMS error the cells' noise predicts (mu0's standard error) and measured:"
+    );
+    println!(
+        "  {:>6} {:>14} {:>14} {:>14}",
+        "load N", "predicted %", "measured mean %", "measured worst %"
+    );
+    for load in ENVELOPE_LOADS_N.iter().filter(|&&l| l < 1.0) {
+        let mut predicted = Vec::new();
+        let mut measured = Vec::new();
+        for (k, (point, file)) in points.iter().zip(loaded).enumerate() {
+            if point.load_n != *load {
+                continue;
+            }
+            let point_scene = file.scene();
+            let settings = sonolube::control::controller_settings(&point_scene);
+            // mu0 is learned from the sliding debounce to the first target change.
+            let change_s = point_scene
+                .target
+                .iter()
+                .map(|p| p.at_s)
+                .find(|&t| t > 0.0)
+                .unwrap_or(point_scene.duration_s);
+            let learn_s = (change_s - settings.sliding_debounce_s).max(settings.natural_learn_s);
+            if let Some(e) = sonolube::control::noise_rms_error(&settings, learn_s) {
+                predicted.push(100.0 * e);
+            }
+            for r in results[k * seeds..(k + 1) * seeds].iter().flatten() {
+                if let Some(v) = r.verdicts.get(rms_index).and_then(|v| value_of(v.measured)) {
+                    measured.push(v);
+                }
+            }
+        }
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+        println!(
+            "  {:>6} {:>14.3} {:>14.3} {:>14.3}",
+            load,
+            mean(&predicted),
+            mean(&measured),
+            measured.iter().copied().fold(f64::NAN, f64::max)
+        );
+    }
 }
 
 /// Runs `runs` again, each changed by `change`, and prints how many pass (`what` says how
