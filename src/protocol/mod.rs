@@ -57,7 +57,8 @@
 //! | `load` | | drive off: apply the stored settings, checked (version, CRC, ranges) | `ok settings=loaded ...` (the same fields) |
 //! | `defaults` | | drive off: the scene's datasheet calibration and drive frequency, no target; flash unchanged until `save` | `ok settings=defaults scene=reference cal_count=0 normal_offset_q31=none ...` |
 //! | `log` | | boots, watchdog resets, where this boot's settings came from, the last 8 faults and resets | `ok boots=3 watchdog_resets=1 boot_settings=defaults boot_reason=crc-mismatch events=watchdog-reset,overcurrent` |
-//! | `help` | | list the commands | `ok commands=version,status,faults,target,scene,start,stop,freq,tare,cal,clear,telemetry,save,load,defaults,log,help` |
+//! | `help` | | list the commands | `ok commands=version,status,faults,target,scene,start,stop,freq,tare,cal,clear,telemetry,save,load,defaults,log,help,commission` |
+//! | `commission` | | drive off, contact loaded and sliding: search the resonance, ring the stack down, measure mu0 with the drive off (see [`crate::commission`]); the loop then runs on the measured f0 and time constant; `status` reports the step, the result or the refusal | `ok commission=started` |
 //!
 //! Numbers are `[+-]digits[.digits]`: at least one digit before a `.` and one after it, no
 //! exponent, no unit, at most 12 digits in all. A value is never rounded: a non-zero digit

@@ -101,6 +101,7 @@ pub fn parse_command(line: &str) -> Result<Command, ProtocolError> {
         "defaults" => (Command::Defaults, "defaults"),
         "log" => (Command::Log, "log"),
         "help" => (Command::Help, "help"),
+        "commission" => (Command::Commission, "commission"),
         other => {
             return Err(ProtocolError::UnknownCommand {
                 token: TokenText::new(other),
@@ -282,6 +283,7 @@ mod tests {
             ("telemetry 100", Command::Telemetry { rate_hz: 100 }),
             ("telemetry off", Command::TelemetryOff),
             ("help", Command::Help),
+            ("commission", Command::Commission),
             ("save", Command::Save),
             ("load", Command::Load),
             ("defaults", Command::Defaults),

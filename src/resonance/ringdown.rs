@@ -109,7 +109,8 @@ pub fn fit_ring_down(
     }
     let mut points = amplitudes_lsb.clone();
     let start = points.next().unwrap_or(0.0);
-    if !(start >= MIN_RING_DOWN_START_LSB) {
+    // NaN is refused too.
+    if start.is_nan() || start < MIN_RING_DOWN_START_LSB {
         return Err(RingDownError::TooSmall(start));
     }
     let floor = libm::fmax(
@@ -141,7 +142,7 @@ pub fn fit_ring_down(
         sty += w * (t - t_mean) * (y - y_mean);
     }
     let slope = sty / stt;
-    if !(slope < 0.0) {
+    if slope.is_nan() || slope >= 0.0 {
         return Err(RingDownError::NoDecay);
     }
     let intercept = y_mean - slope * t_mean;
