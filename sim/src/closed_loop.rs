@@ -126,7 +126,7 @@ impl<'a> ClosedLoop<'a> {
         let normal = super::sensor_channel(&scene.normal_cell)?;
         let tangential = super::sensor_channel(&scene.tangential_cell)?;
         let station = Station::with_model(scene, &settings, model, normal, tangential)?;
-        Self::scripted(scene, station, COMMISSIONED)
+        Self::scripted(scene, station, COMMISSIONED, None)
     }
 
     /// [`ClosedLoop::new`] with the variant `selection` names ([`Station::with_selection`]):
@@ -150,6 +150,19 @@ impl<'a> ClosedLoop<'a> {
         } else {
             None
         };
+        Self::with_commissioned(scene, selection, calibration, commissioned)
+    }
+
+    /// [`ClosedLoop::with_selection_calibrated`] with the commissioning already done
+    /// (`commissioned`, from [`commission_rig`]; `None`: the declared values). The QEMU board
+    /// commissions first and builds the run after, so that its stack never holds the rig's run
+    /// and the scene's at once.
+    pub fn with_commissioned(
+        scene: &Scene<'a>,
+        selection: sonolube::variant::Selection,
+        calibration: CellCalibration,
+        commissioned: Option<CommissionResult>,
+    ) -> Result<Self, SimError> {
         // The variant is the scene's choice; its parameters, the measured ones.
         let controller_scene = commissioned
             .as_ref()
@@ -159,9 +172,9 @@ impl<'a> ClosedLoop<'a> {
         let tangential = super::sensor_channel(&scene.tangential_cell)?;
         let station =
             Station::with_selection(&controller_scene, &settings, selection, normal, tangential)?;
-        let mut run = Self::scripted(scene, station, calibration)?;
-        run.commissioned = commissioned;
-        Ok(run)
+        // Built with the result in place: the run (14 KB) is not copied once more, which the
+        // QEMU board's stack would feel.
+        Self::scripted(scene, station, calibration, commissioned)
     }
 
     /// What commissioning measured before this run; `None` unless the scene has
@@ -176,7 +189,7 @@ impl<'a> ClosedLoop<'a> {
         settings: &Settings,
         calibration: CellCalibration,
     ) -> Result<Self, SimError> {
-        Self::scripted(scene, scene_station(scene, settings)?, calibration)
+        Self::scripted(scene, scene_station(scene, settings)?, calibration, None)
     }
 
     /// The scripted run of `scene` on `station`: first target set, started.
@@ -184,8 +197,9 @@ impl<'a> ClosedLoop<'a> {
         scene: &Scene<'a>,
         station: Station,
         calibration: CellCalibration,
+        commissioned: Option<CommissionResult>,
     ) -> Result<Self, SimError> {
-        let mut run = Self::build(scene, station, calibration, Mode::Scripted)?;
+        let mut run = Self::build(scene, station, calibration, Mode::Scripted, commissioned)?;
         if scene.target.iter().any(|point| !point.target.is_valid()) {
             return Err(SimError::InvalidTarget);
         }
@@ -213,7 +227,7 @@ impl<'a> ClosedLoop<'a> {
     /// cells, the scene's controller settings, idle, no target.
     pub fn operated(scene: &Scene<'a>) -> Result<Self, SimError> {
         let station = scene_station(scene, &controller_settings(scene))?;
-        Self::build(scene, station, COMMISSIONED, Mode::Operated)
+        Self::build(scene, station, COMMISSIONED, Mode::Operated, None)
     }
 
     fn build(
@@ -221,6 +235,7 @@ impl<'a> ClosedLoop<'a> {
         mut station: Station,
         calibration: CellCalibration,
         mode: Mode,
+        commissioned: Option<CommissionResult>,
     ) -> Result<Self, SimError> {
         let plant = Plant::from_scene(scene).map_err(SimError::Plant)?;
         if scene.transducer.shift.bvd_envelope {
@@ -240,7 +255,7 @@ impl<'a> ClosedLoop<'a> {
             target_points: 1,
             phase: Phase::Plant,
             judge: Judge::new(scene).ok_or(SimError::TooLarge)?,
-            commissioned: None,
+            commissioned,
         })
     }
 

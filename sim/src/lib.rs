@@ -47,7 +47,7 @@ pub use judge::{
     DEFAULT_BAND, DEFAULT_STEADY_AFTER_S, Judge, MAX_CRITERIA, MAX_FAULTS, MAX_SEGMENTS,
 };
 pub use quantity::{Judged, Quantity, target_friction_n, target_value};
-pub use rig_commission::commission_rig;
+pub use rig_commission::{commission_rig, rig_commission_outcome, rig_scene, start_rig_commission};
 pub use setup::{
     MAX_STEP_OF_SPAN, STUCK_MIN_NOISE_STEPS, STUCK_SAMPLES, cell_format, fault_limits,
     nominal_calibration, scene_station, sensor_channel,

@@ -21,25 +21,46 @@ use super::{ClosedLoop, SimError};
 /// (`sonolube::commission`), and 0.5 s more covers the quiet step of the slowest Q.
 const RIG_LIMIT_S: f64 = 5.5;
 
-/// Commissions `scene`'s simulated rig: the result the firmware's sequence accepted, or why it
-/// refused ([`SimError::Commission`]).
-pub fn commission_rig(scene: &Scene<'_>) -> Result<CommissionResult, SimError> {
+/// The scene of `scene`'s simulated rig: the scene, its transducer sampling its drive current,
+/// no search at start, not itself commissioned.
+pub fn rig_scene<'a>(scene: &Scene<'a>) -> Scene<'a> {
     let mut rig_scene = *scene;
     rig_scene.transducer.shift.bvd_envelope = true;
     rig_scene.transducer.shift.freq_auto = false;
     rig_scene.commission = false;
-    let mut rig = ClosedLoop::operated(&rig_scene)?;
+    rig_scene
+}
+
+/// Starts the sequence on `rig` ([`ClosedLoop::operated`] of [`rig_scene`], just built).
+/// The QEMU board then steps it in its control loop; [`commission_rig`] steps it here.
+pub fn start_rig_commission(rig: &mut ClosedLoop<'_>) -> Result<(), SimError> {
     rig.execute(&Command::Commission)
-        .map_err(SimError::Resonance)?;
+        .map_err(SimError::Resonance)
+}
+
+/// How the commissioning on `rig` ended: `None` while it runs.
+pub fn rig_commission_outcome(rig: &ClosedLoop<'_>) -> Option<Result<CommissionResult, SimError>> {
+    match rig.station().commission_report() {
+        CommissionReport::Running(_) | CommissionReport::Never => None,
+        CommissionReport::Done(result) => Some(Ok(result)),
+        CommissionReport::Refused(refusal) => {
+            Some(Err(SimError::Commission(refusal.step, refusal.reason)))
+        }
+    }
+}
+
+/// Commissions `scene`'s simulated rig: the result the firmware's sequence accepted, or why it
+/// refused ([`SimError::Commission`]). Never inlined: the rig's run (14 KB) lives in this
+/// function's own frame, gone before the caller builds the scene's run.
+#[inline(never)]
+pub fn commission_rig(scene: &Scene<'_>) -> Result<CommissionResult, SimError> {
+    let mut rig = ClosedLoop::operated(&rig_scene(scene))?;
+    start_rig_commission(&mut rig)?;
     let limit = libm::ceil(RIG_LIMIT_S * scene.control_rate_hz) as u32;
     for _ in 0..limit {
         rig.step();
-        match rig.station().commission_report() {
-            CommissionReport::Running(_) | CommissionReport::Never => {}
-            CommissionReport::Done(result) => return Ok(result),
-            CommissionReport::Refused(refusal) => {
-                return Err(SimError::Commission(refusal.step, refusal.reason));
-            }
+        if let Some(outcome) = rig_commission_outcome(&rig) {
+            return outcome;
         }
     }
     Err(SimError::Commission(

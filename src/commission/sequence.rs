@@ -57,11 +57,18 @@ pub enum Phase {
 }
 
 /// Ring-down groups held: 256 (1024 drive periods; three time constants of Q = 800 at 40 kHz.
-/// A longer ring-down fits its first 256 groups, still above the floor).
+/// A longer ring-down fits its first 256 groups, still above the floor). Each is held as
+/// `16 A` in a `u16` (1/16 LSB, a hundredth of the sense's noise; `A` is at most
+/// `2048 sqrt 2 = 2896` LSB, `16 A` below 46 341): 512 bytes in the station.
 const RING_DOWN_CAPACITY: usize = 256;
 
-/// Control periods of the burst's detuning window: the last 64 settled ones.
-const DETUNING_WINDOW: usize = 64;
+/// Control periods of the burst's detuning window: the last 32 settled ones.
+const DETUNING_WINDOW: usize = 32;
+
+/// `16 A` of a group's `4 A^2` (`sqrt(64 x 4 A^2)`), exact integer square root, rounded down.
+fn sixteenths(amplitude_squared_x4: u64) -> u16 {
+    (amplitude_squared_x4.saturating_mul(64).isqrt()).min(u64::from(u16::MAX)) as u16
+}
 
 /// Longest any one step may take, s: one second (a search, a burst of Q = 5000 at 20 kHz,
 /// 12 time constants, or a contact that never slides).
@@ -84,7 +91,7 @@ pub struct Commissioning {
     /// (drive frequency mHz, detuning Q8.24 bits) of the settled burst periods, a ring.
     detuning: [(u32, i32); DETUNING_WINDOW],
     detuning_count: usize,
-    ring_down: [u32; RING_DOWN_CAPACITY],
+    ring_down: [u16; RING_DOWN_CAPACITY],
     ring_down_len: usize,
     ring_down_closed: bool,
     /// Drive frequency over the ring-down, mHz.
@@ -198,20 +205,20 @@ impl Commissioning {
                 }
             }
             Step::RingDown if !self.ring_down_closed => {
-                let amplitude = group_amplitude_lsb(amplitude_squared);
+                let amplitude = sixteenths(amplitude_squared);
+                let amplitude_lsb = f64::from(amplitude) / 16.0;
                 let first = self
                     .ring_down
                     .first()
                     .filter(|_| self.ring_down_len > 0)
-                    .map_or(amplitude, |&s| group_amplitude_lsb(u64::from(s)));
+                    .map_or(amplitude_lsb, |&a| f64::from(a) / 16.0);
                 let floor = libm::fmax(
                     first * libm::exp(-RING_DOWN_SPAN_TIME_CONSTANTS),
                     RING_DOWN_FLOOR_LSB,
                 );
                 match self.ring_down.get_mut(self.ring_down_len) {
-                    // 2 x 4095^2 fits a u32.
-                    Some(slot) if amplitude >= floor => {
-                        *slot = amplitude_squared as u32;
+                    Some(slot) if amplitude_lsb >= floor => {
+                        *slot = amplitude;
                         self.ring_down_len += 1;
                     }
                     _ => self.ring_down_closed = true,
@@ -325,7 +332,7 @@ impl Commissioning {
             .get(..self.ring_down_len)
             .unwrap_or(&[])
             .iter()
-            .map(|&s| group_amplitude_lsb(u64::from(s)));
+            .map(|&a| f64::from(a) / 16.0);
         let fit = fit_ring_down(points, 4.0 / f_hz).map_err(|e| {
             let value = match e {
                 crate::resonance::RingDownError::TooSmall(lsb) => lsb,
