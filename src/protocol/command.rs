@@ -102,6 +102,8 @@ pub enum Command {
     /// `commission`: measure the resonance, the envelope time constant (ring-down), mu0
     /// (sliding, drive off) and report the cells' zeros; the loop then runs on them.
     Commission,
+    /// `commission status`: the last commissioning's step, result or refusal.
+    CommissionStatus,
 }
 
 /// The keywords, in the order `help` lists them.
@@ -147,7 +149,7 @@ impl Command {
             Command::Defaults => "defaults",
             Command::Log => "log",
             Command::Help => "help",
-            Command::Commission => "commission",
+            Command::Commission | Command::CommissionStatus => "commission",
         }
     }
 }
@@ -207,6 +209,7 @@ pub fn format_command(command: &Command, out: &mut StringView) -> Result<(), For
             | Command::Log
             | Command::Help
             | Command::Commission => {}
+            Command::CommissionStatus => put(out, " status")?,
         }
         put(out, "\n")
     })
@@ -268,6 +271,7 @@ pub(crate) mod tests {
             Just(Command::Log),
             Just(Command::Help),
             Just(Command::Commission),
+            Just(Command::CommissionStatus),
         ]
     }
 
@@ -313,6 +317,7 @@ pub(crate) mod tests {
             (Command::SceneList, "scene list\n"),
             (Command::Help, "help\n"),
             (Command::Commission, "commission\n"),
+            (Command::CommissionStatus, "commission status\n"),
             (Command::Save, "save\n"),
             (Command::Load, "load\n"),
             (Command::Defaults, "defaults\n"),

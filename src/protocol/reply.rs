@@ -147,6 +147,7 @@ pub fn format_ack(command: &Command, out: &mut StringView) -> Result<(), FormatE
         Command::TelemetryOff => reply.word("telemetry_hz", "off"),
         Command::Help => reply.list("commands", &KEYWORDS),
         Command::Commission => reply.word("commission", "started"),
+        Command::CommissionStatus => reply,
         Command::Version
         | Command::Status
         | Command::Faults

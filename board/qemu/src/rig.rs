@@ -259,6 +259,10 @@ impl Persistent for SimulatedRig {
     fn latched_fault(&self) -> Option<Reason> {
         self.run.controller().fault()
     }
+
+    fn commission(&self) -> sonolube::station::CommissionReport {
+        self.run.station().commission_report()
+    }
 }
 
 impl ControlLoop for SimulatedRig {
