@@ -121,3 +121,64 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod refusals {
+    use super::*;
+    use sonolube::commission::Step;
+    use sonolube::protocol::{ProtocolError, SupervisorState};
+    use sonolube::scene::{Breakpoint, find};
+
+    #[test]
+    fn a_rig_that_does_not_sample_its_current_cannot_commission() {
+        let scene = find("reference").expect("built in");
+        let mut run = ClosedLoop::operated(scene).expect("operated");
+        assert!(matches!(
+            run.execute(&Command::Commission),
+            Err(ProtocolError::Unavailable { .. })
+        ));
+        assert_eq!(run.station().commission_report(), CommissionReport::Never);
+    }
+
+    #[test]
+    fn while_commissioning_the_loop_refuses_its_commands_and_stop_ends_it() {
+        let scene = find("reference").expect("built in");
+        let mut rig = ClosedLoop::operated(&rig_scene(scene)).expect("operated");
+        start_rig_commission(&mut rig).expect("started");
+        for _ in 0..20 {
+            rig.step();
+        }
+        assert_eq!(rig.station().state(), SupervisorState::Tuning);
+        assert!(matches!(
+            rig.execute(&Command::Start),
+            Err(ProtocolError::WrongState {
+                state: SupervisorState::Tuning,
+                ..
+            })
+        ));
+        assert!(matches!(
+            rig.execute(&Command::Commission),
+            Err(ProtocolError::WrongState { .. })
+        ));
+        rig.execute(&Command::Stop).expect("stop ends it");
+        match rig.station().commission_report() {
+            CommissionReport::Refused(refusal) => assert_eq!(refusal.reason, "stopped"),
+            other => panic!("{other:?}"),
+        }
+        assert_ne!(rig.station().state(), SupervisorState::Tuning);
+    }
+
+    #[test]
+    fn a_contact_that_does_not_slide_gives_no_mu0() {
+        static STILL: [Breakpoint; 1] = [Breakpoint {
+            t_s: 0.0,
+            value: 0.0,
+        }];
+        let mut scene = *find("reference").expect("built in");
+        scene.sliding_velocity_m_per_s = &STILL;
+        assert_eq!(
+            commission_rig(&scene),
+            Err(SimError::Commission(Step::Natural, "not sliding with load"))
+        );
+    }
+}
