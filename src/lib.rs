@@ -6,6 +6,7 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod commission;
 pub mod control;
 pub mod drive;
 pub mod ext_adc;

@@ -39,6 +39,11 @@ use crate::scene::Scene;
 use crate::sense::{SampleError, SensorChannel};
 use crate::variant::{Selection, select};
 
+mod commission;
+
+pub use commission::CommissionReport;
+use commission::CommissionState;
+
 /// What a board gives the station each period.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -118,6 +123,10 @@ pub struct Station {
     /// The drive amplitude the station returned last (what the drive applies over the
     /// period whose current samples come next).
     applied: Amplitude,
+    /// The controller's settings (commissioning replaces the measured ones).
+    settings: Settings,
+    /// The last `commission` ([`crate::commission`]).
+    commission: CommissionState,
 }
 
 /// The current sense the station assumes for the resonance loop: the NUCLEO-G474RE's
@@ -216,6 +225,8 @@ impl Station {
             start_pending: false,
             current_sense: false,
             applied: Amplitude::ZERO,
+            settings: *settings,
+            commission: CommissionState::Never,
         })
     }
 
@@ -242,7 +253,12 @@ impl Station {
             count += 1;
         }
         let taken = samples.get(..count).unwrap_or(&[]);
-        if resonance.push(taken, self.applied).is_err() {
+        let push = resonance.push(taken, self.applied);
+        self.commission_current(codes.get(..count).unwrap_or(&[]));
+        let Some(resonance) = self.resonance.as_mut() else {
+            return;
+        };
+        if push.is_err() {
             self.start_pending = false;
             self.controller.trip(ExternalFault::ResonanceLost);
         }
@@ -285,6 +301,7 @@ impl Station {
         if let Some(resonance) = self.resonance.as_ref() {
             let drive_allowed = output.fault.is_none()
                 && (self.start_pending
+                    || self.commissioning()
                     || matches!(
                         output.state,
                         crate::protocol::SupervisorState::RampUp
@@ -311,6 +328,12 @@ impl Station {
             }
         }
         self.applied = drive_amplitude(output.amplitude);
+        self.commission_period(
+            &mut output,
+            normal_force,
+            tangential_force,
+            sample.sliding_velocity_m_per_s,
+        );
         Control {
             output,
             sensor_fault,
@@ -327,7 +350,21 @@ impl Station {
         bench: &mut impl CellBench,
     ) -> Result<(), ProtocolError> {
         let refused = |e: crate::control::ControlError| e.to_protocol();
+        if self.commissioning() {
+            // The sequence owns the drive until it ends; `stop` ends it.
+            return match command {
+                Command::Stop => {
+                    self.cancel_commission();
+                    Ok(())
+                }
+                _ => Err(ProtocolError::WrongState {
+                    command: command.keyword(),
+                    state: SupervisorState::Tuning,
+                }),
+            };
+        }
         match *command {
+            Command::Commission => self.start_commission(command),
             Command::Target(target) => self.controller.set_target(target).map_err(refused),
             Command::Start if self.auto_armed => {
                 // Refused for the controller's reasons (no target, fault latched) before
@@ -502,9 +539,13 @@ impl Station {
         }
     }
 
-    /// The supervisor's present state.
+    /// The supervisor's present state (`tuning` while commissioning runs).
     pub fn state(&self) -> SupervisorState {
-        self.controller.state()
+        if self.commissioning() {
+            SupervisorState::Tuning
+        } else {
+            self.controller.state()
+        }
     }
 
     /// The drive frequency, Hz.

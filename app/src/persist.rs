@@ -39,7 +39,11 @@ pub static REPLY: Mutex<CriticalSectionRawMutex, RefCell<String<REPLY_CAPACITY>>
 pub fn has_reply(command: &Command) -> bool {
     matches!(
         command,
-        Command::Save | Command::Load | Command::Defaults | Command::Log
+        Command::Save
+            | Command::Load
+            | Command::Defaults
+            | Command::Log
+            | Command::CommissionStatus
     )
 }
 
@@ -73,6 +77,11 @@ pub trait Persistent {
     fn state(&self) -> SupervisorState;
     /// The latched fault, if any.
     fn latched_fault(&self) -> Option<Reason>;
+    /// The last `commission` (`commission status`); a loop that cannot commission says
+    /// `none`.
+    fn commission(&self) -> sonolube::station::CommissionReport {
+        sonolube::station::CommissionReport::Never
+    }
 }
 
 /// A board's loop with its settings store. Without a store (a run given no flash) `save` and
@@ -280,6 +289,13 @@ impl<L: ControlLoop + Persistent, F: NorFlash> ControlLoop for Persisted<L, F> {
         match command {
             Command::Save | Command::Load | Command::Defaults | Command::Log => {
                 self.settings_command(command)
+            }
+            Command::CommissionStatus => {
+                let report = self.inner.commission();
+                set_reply(|out| {
+                    sonolube::protocol::format_commission(&report, out.as_mut_view()).is_ok()
+                });
+                Ok(())
             }
             Command::Tare(_) | Command::Cal { .. } => {
                 self.inner.execute(command)?;

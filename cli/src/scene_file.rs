@@ -80,6 +80,7 @@ impl LoadedScene {
             accuracy: d.accuracy,
             criteria: &d.criteria,
             contents: d.contents,
+            commission: d.commission,
         }
     }
 }

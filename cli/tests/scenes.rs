@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use sonolube::protocol::{Target, is_scene_name};
 use sonolube::scene::{self, Criterion, ModelKind, SCENES, System, target_at};
 use sonolube_cli::scene_file::{LoadedScene, out_of_reach, scenes_dir, target_ratio};
+use sonolube_sim::ClosedLoop;
 use sonolube_sim::plant::Plant;
 
 fn loaded() -> Vec<LoadedScene> {
@@ -353,6 +354,35 @@ fn a_user_file_loads_and_runs_without_being_compiled_in() {
     let readings = plant.step(0.0, 40_000.0);
     assert_eq!(readings.truth.normal_load_n, 1.902);
     std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn a_scene_may_ask_for_commissioning_and_its_run_uses_the_measured_values() {
+    let text = reference_text();
+    let declared = scene_toml::parse(&text, "reference.toml").expect("loads");
+    assert!(!declared.commission);
+    let with_key = text.replacen(
+        "noise_seed = 1001",
+        "noise_seed = 1001\ncommission = true",
+        1,
+    );
+    assert_ne!(with_key, text);
+    let description = scene_toml::parse(&with_key, "reference.toml").expect("loads");
+    assert!(description.commission);
+    let loaded = LoadedScene::from_description(description);
+    let scene = loaded.scene();
+    assert!(scene.commission);
+    let run = ClosedLoop::new(&scene).expect("commissioned run");
+    let result = run.commissioned().expect("commissioned before the run");
+    // The run drives at the measured f0 (39 999.66 Hz), not the declared 40 kHz.
+    let f0_chz = (result.resonance_hz.value * 100.0).round() as u32;
+    assert_eq!(run.station().drive_freq_chz(), f0_chz);
+    assert_ne!(f0_chz, 4_000_000);
+    assert!(
+        (result.quality_factor.value - 100.0).abs() < 4.0 * result.quality_factor.standard_error
+    );
+    let wrong = text.replacen("noise_seed = 1001", "noise_seed = 1001\ncommission = 1", 1);
+    assert!(scene_toml::parse(&wrong, "edited.toml").is_err());
 }
 
 /// The error for `text` with `from` replaced by `to`, as `key: reason`.

@@ -61,6 +61,7 @@ fn scene_literal(s: &SceneDescription) -> String {
     field("accuracy", accuracy(&s.accuracy));
     field("criteria", slice(&s.criteria, criterion));
     field("contents", contents(&s.contents));
+    field("commission", s.commission.to_string());
     out.push_str(" }");
     out
 }

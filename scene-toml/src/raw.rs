@@ -16,6 +16,7 @@ pub(crate) struct RawScene {
     pub duration_s: f64,
     pub plant_substeps: Option<i64>,
     pub noise_seed: Option<i64>,
+    pub commission: Option<bool>,
     pub controller: RawModel,
     pub plant: RawModel,
     pub actuator: RawActuator,

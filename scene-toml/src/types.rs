@@ -54,6 +54,8 @@ pub struct SceneDescription {
     pub sliding_velocity_m_per_s: Vec<Breakpoint>,
     /// Target table.
     pub target: Vec<TargetPoint>,
+    /// The run uses commissioned f0, Q and mu0 (`commission = true`; default false).
+    pub commission: bool,
     /// Accuracy needs.
     pub accuracy: Accuracy,
     /// Pass criteria.

@@ -147,6 +147,7 @@ pub(crate) fn scene(raw: RawScene, errors: Errors<'_>) -> Result<SceneDescriptio
         normal_load_n: Vec::new(),
         sliding_velocity_m_per_s: Vec::new(),
         target: Vec::new(),
+        commission: raw.commission.unwrap_or(false),
         accuracy: tables::accuracy(errors, &raw.accuracy)?,
         criteria: Vec::new(),
         contents: tables::contents(errors, &raw.contents)?,

@@ -19,9 +19,11 @@ use super::SimError;
 use super::commission::{COMMISSIONED, CellCalibration, commission};
 use super::judge::Judge;
 use super::quantity::{Judged, target_friction_n};
+use super::rig_commission::commission_rig;
 use super::setup::scene_station;
 use super::summary::{Observation, RunSummary};
 use crate::plant::{Gaussian, LoadCellSim, Plant, SensorReadings};
+use sonolube::commission::{CommissionResult, commissioned_scene};
 use sonolube::control::{
     Controller, ExternalFault, Output, Reason, SensorFault, Settings, controller_settings,
 };
@@ -102,14 +104,18 @@ pub struct ClosedLoop<'a> {
     target_points: usize,
     phase: Phase,
     judge: Judge,
+    /// What commissioning measured before the run (`commission = true` scenes).
+    commissioned: Option<CommissionResult>,
 }
 
 impl<'a> ClosedLoop<'a> {
     /// The run of `scene` with the model variant the scene selects ([`Station::new`]), the
     /// controller settings made from it ([`controller_settings`]) and commissioned cells
-    /// ([`COMMISSIONED`]), at t = 0 with the first target set and started.
+    /// ([`COMMISSIONED`]), at t = 0 with the first target set and started. A scene with
+    /// `commission = true` is commissioned first ([`commission_rig`]) and its controller runs
+    /// on the measured values ([`commissioned_scene`]).
     pub fn new(scene: &Scene<'a>) -> Result<Self, SimError> {
-        Self::with_settings(scene, &controller_settings(scene), COMMISSIONED)
+        Self::with_selection_calibrated(scene, sonolube::variant::select(scene), COMMISSIONED)
     }
 
     /// [`ClosedLoop::new`] with the controller running `model` instead of the variant the
@@ -120,7 +126,7 @@ impl<'a> ClosedLoop<'a> {
         let normal = super::sensor_channel(&scene.normal_cell)?;
         let tangential = super::sensor_channel(&scene.tangential_cell)?;
         let station = Station::with_model(scene, &settings, model, normal, tangential)?;
-        Self::scripted(scene, station, COMMISSIONED)
+        Self::scripted(scene, station, COMMISSIONED, None)
     }
 
     /// [`ClosedLoop::new`] with the variant `selection` names ([`Station::with_selection`]):
@@ -139,11 +145,42 @@ impl<'a> ClosedLoop<'a> {
         selection: sonolube::variant::Selection,
         calibration: CellCalibration,
     ) -> Result<Self, SimError> {
-        let settings = controller_settings(scene);
+        let commissioned = if scene.commission {
+            Some(commission_rig(scene)?)
+        } else {
+            None
+        };
+        Self::with_commissioned(scene, selection, calibration, commissioned)
+    }
+
+    /// [`ClosedLoop::with_selection_calibrated`] with the commissioning already done
+    /// (`commissioned`, from [`commission_rig`]; `None`: the declared values). The QEMU board
+    /// commissions first and builds the run after, so that its stack never holds the rig's run
+    /// and the scene's at once.
+    pub fn with_commissioned(
+        scene: &Scene<'a>,
+        selection: sonolube::variant::Selection,
+        calibration: CellCalibration,
+        commissioned: Option<CommissionResult>,
+    ) -> Result<Self, SimError> {
+        // The variant is the scene's choice; its parameters, the measured ones.
+        let controller_scene = commissioned
+            .as_ref()
+            .map_or(*scene, |result| commissioned_scene(scene, result));
+        let settings = controller_settings(&controller_scene);
         let normal = super::sensor_channel(&scene.normal_cell)?;
         let tangential = super::sensor_channel(&scene.tangential_cell)?;
-        let station = Station::with_selection(scene, &settings, selection, normal, tangential)?;
-        Self::scripted(scene, station, calibration)
+        let station =
+            Station::with_selection(&controller_scene, &settings, selection, normal, tangential)?;
+        // Built with the result in place: the run (14 KB) is not copied once more, which the
+        // QEMU board's stack would feel.
+        Self::scripted(scene, station, calibration, commissioned)
+    }
+
+    /// What commissioning measured before this run; `None` unless the scene has
+    /// `commission = true`.
+    pub fn commissioned(&self) -> Option<&CommissionResult> {
+        self.commissioned.as_ref()
     }
 
     /// The run of `scene` with the controller `settings` and the cells' `calibration` given.
@@ -152,7 +189,7 @@ impl<'a> ClosedLoop<'a> {
         settings: &Settings,
         calibration: CellCalibration,
     ) -> Result<Self, SimError> {
-        Self::scripted(scene, scene_station(scene, settings)?, calibration)
+        Self::scripted(scene, scene_station(scene, settings)?, calibration, None)
     }
 
     /// The scripted run of `scene` on `station`: first target set, started.
@@ -160,8 +197,9 @@ impl<'a> ClosedLoop<'a> {
         scene: &Scene<'a>,
         station: Station,
         calibration: CellCalibration,
+        commissioned: Option<CommissionResult>,
     ) -> Result<Self, SimError> {
-        let mut run = Self::build(scene, station, calibration, Mode::Scripted)?;
+        let mut run = Self::build(scene, station, calibration, Mode::Scripted, commissioned)?;
         if scene.target.iter().any(|point| !point.target.is_valid()) {
             return Err(SimError::InvalidTarget);
         }
@@ -170,7 +208,8 @@ impl<'a> ClosedLoop<'a> {
         controller
             .set_target(first.target)
             .map_err(SimError::Control)?;
-        if scene.transducer.shift.freq_auto {
+        // A commissioned run starts at the measured f0: no search.
+        if scene.transducer.shift.freq_auto && !scene.commission {
             // `freq auto` then `start`, as an operator would: the search runs first and the
             // friction loop starts at its lock.
             let mut bench = SimulatedCells { scene, burst: 0 };
@@ -188,7 +227,7 @@ impl<'a> ClosedLoop<'a> {
     /// cells, the scene's controller settings, idle, no target.
     pub fn operated(scene: &Scene<'a>) -> Result<Self, SimError> {
         let station = scene_station(scene, &controller_settings(scene))?;
-        Self::build(scene, station, COMMISSIONED, Mode::Operated)
+        Self::build(scene, station, COMMISSIONED, Mode::Operated, None)
     }
 
     fn build(
@@ -196,6 +235,7 @@ impl<'a> ClosedLoop<'a> {
         mut station: Station,
         calibration: CellCalibration,
         mode: Mode,
+        commissioned: Option<CommissionResult>,
     ) -> Result<Self, SimError> {
         let plant = Plant::from_scene(scene).map_err(SimError::Plant)?;
         if scene.transducer.shift.bvd_envelope {
@@ -218,6 +258,7 @@ impl<'a> ClosedLoop<'a> {
             target_points: 1,
             phase: Phase::Plant,
             judge: Judge::new(scene).ok_or(SimError::TooLarge)?,
+            commissioned,
         })
     }
 

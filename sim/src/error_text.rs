@@ -41,6 +41,13 @@ impl fmt::Display for SimError {
             Self::Resonance(error) => {
                 write!(f, "the scene's resonance loop refused its start: {error:?}")
             }
+            Self::Commission(step, reason) => {
+                write!(
+                    f,
+                    "commissioning refused at its {} step: {reason}",
+                    step.name()
+                )
+            }
         }
     }
 }

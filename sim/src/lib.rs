@@ -32,6 +32,7 @@ mod commission;
 mod error_text;
 mod judge;
 mod quantity;
+mod rig_commission;
 mod setup;
 mod summary;
 
@@ -46,6 +47,7 @@ pub use judge::{
     DEFAULT_BAND, DEFAULT_STEADY_AFTER_S, Judge, MAX_CRITERIA, MAX_FAULTS, MAX_SEGMENTS,
 };
 pub use quantity::{Judged, Quantity, target_friction_n, target_value};
+pub use rig_commission::{commission_rig, rig_commission_outcome, rig_scene, start_rig_commission};
 pub use setup::{
     MAX_STEP_OF_SPAN, STUCK_MIN_NOISE_STEPS, STUCK_SAMPLES, cell_format, fault_limits,
     nominal_calibration, scene_station, sensor_channel,
@@ -82,6 +84,9 @@ pub enum SimError {
     TooLarge,
     /// The scene asks for `freq auto` and the station refused it or the start after it.
     Resonance(sonolube::protocol::ProtocolError),
+    /// The scene asks for `commission = true` and the firmware's commissioning refused its
+    /// result: the step and the reason ([`sonolube::commission::Refusal`]).
+    Commission(sonolube::commission::Step, &'static str),
 }
 
 impl From<StationError> for SimError {

@@ -99,10 +99,15 @@ pub enum Command {
     Log,
     /// `help`: the list of commands.
     Help,
+    /// `commission`: measure the resonance, the envelope time constant (ring-down), mu0
+    /// (sliding, drive off) and report the cells' zeros; the loop then runs on them.
+    Commission,
+    /// `commission status`: the last commissioning's step, result or refusal.
+    CommissionStatus,
 }
 
 /// The keywords, in the order `help` lists them.
-pub const KEYWORDS: [&str; 17] = [
+pub const KEYWORDS: [&str; 18] = [
     "version",
     "status",
     "faults",
@@ -120,6 +125,7 @@ pub const KEYWORDS: [&str; 17] = [
     "defaults",
     "log",
     "help",
+    "commission",
 ];
 
 impl Command {
@@ -143,6 +149,7 @@ impl Command {
             Command::Defaults => "defaults",
             Command::Log => "log",
             Command::Help => "help",
+            Command::Commission | Command::CommissionStatus => "commission",
         }
     }
 }
@@ -200,7 +207,9 @@ pub fn format_command(command: &Command, out: &mut StringView) -> Result<(), For
             | Command::Load
             | Command::Defaults
             | Command::Log
-            | Command::Help => {}
+            | Command::Help
+            | Command::Commission => {}
+            Command::CommissionStatus => put(out, " status")?,
         }
         put(out, "\n")
     })
@@ -261,6 +270,8 @@ pub(crate) mod tests {
             Just(Command::Defaults),
             Just(Command::Log),
             Just(Command::Help),
+            Just(Command::Commission),
+            Just(Command::CommissionStatus),
         ]
     }
 
@@ -305,6 +316,8 @@ pub(crate) mod tests {
             (Command::TelemetryOff, "telemetry off\n"),
             (Command::SceneList, "scene list\n"),
             (Command::Help, "help\n"),
+            (Command::Commission, "commission\n"),
+            (Command::CommissionStatus, "commission status\n"),
             (Command::Save, "save\n"),
             (Command::Load, "load\n"),
             (Command::Defaults, "defaults\n"),

@@ -57,7 +57,9 @@
 //! | `load` | | drive off: apply the stored settings, checked (version, CRC, ranges) | `ok settings=loaded ...` (the same fields) |
 //! | `defaults` | | drive off: the scene's datasheet calibration and drive frequency, no target; flash unchanged until `save` | `ok settings=defaults scene=reference cal_count=0 normal_offset_q31=none ...` |
 //! | `log` | | boots, watchdog resets, where this boot's settings came from, the last 8 faults and resets | `ok boots=3 watchdog_resets=1 boot_settings=defaults boot_reason=crc-mismatch events=watchdog-reset,overcurrent` |
-//! | `help` | | list the commands | `ok commands=version,status,faults,target,scene,start,stop,freq,tare,cal,clear,telemetry,save,load,defaults,log,help` |
+//! | `help` | | list the commands | `ok commands=version,status,faults,target,scene,start,stop,freq,tare,cal,clear,telemetry,save,load,defaults,log,help,commission` |
+//! | `commission status` | | the last commissioning: `none`, `running` and its step, `done` and the values with their standard errors, or `refused`, its step and reason | `ok commission=done f0_hz=39999.66 f0_se_hz=0.52 q=99.59 q_se=0.62 tau_us=792.6 tau_se_us=5.0 mu0=0.240673 mu0_se=0.000119 points=25 normal_zero_n=0.017 tangential_zero_n=-0.003` |
+//! | `commission` | | drive off, contact loaded and sliding: search the resonance, ring the stack down, measure mu0 with the drive off (see [`crate::commission`]); the loop then runs on the measured f0 and time constant; `status` reports the step, the result or the refusal | `ok commission=started` |
 //!
 //! Numbers are `[+-]digits[.digits]`: at least one digit before a `.` and one after it, no
 //! exponent, no unit, at most 12 digits in all. A value is never rounded: a non-zero digit
@@ -144,6 +146,7 @@
 
 mod code;
 mod command;
+mod commission;
 mod decode;
 mod error;
 mod line;
@@ -167,6 +170,7 @@ mod props;
 
 pub use code::ErrorCode;
 pub use command::{Axis, Command, KEYWORDS, TareAxes, format_command};
+pub use commission::format_commission;
 pub use decode::{DecodeError, ErrorReply, Incoming, Payload, Reply, parse_incoming, parse_reply};
 pub use error::{MAX_QUOTED_TOKEN_LEN, MAX_REASON_LEN, ProtocolError, TokenText};
 pub use line::{LineAssembler, MAX_LINE_LEN};

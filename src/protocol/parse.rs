@@ -101,6 +101,16 @@ pub fn parse_command(line: &str) -> Result<Command, ProtocolError> {
         "defaults" => (Command::Defaults, "defaults"),
         "log" => (Command::Log, "log"),
         "help" => (Command::Help, "help"),
+        "commission" => match words.next() {
+            None => (Command::Commission, "commission [status]"),
+            Some("status") => (Command::CommissionStatus, "commission [status]"),
+            Some(other) => {
+                return Err(ProtocolError::BadChoice {
+                    token: TokenText::new(other),
+                    choices: "status",
+                });
+            }
+        },
         other => {
             return Err(ProtocolError::UnknownCommand {
                 token: TokenText::new(other),
@@ -282,6 +292,8 @@ mod tests {
             ("telemetry 100", Command::Telemetry { rate_hz: 100 }),
             ("telemetry off", Command::TelemetryOff),
             ("help", Command::Help),
+            ("commission", Command::Commission),
+            ("commission status", Command::CommissionStatus),
             ("save", Command::Save),
             ("load", Command::Load),
             ("defaults", Command::Defaults),
@@ -345,6 +357,8 @@ mod tests {
             ("freq fast", ErrorCode::BadChoice),
             ("telemetry on", ErrorCode::BadChoice),
             ("tare both", ErrorCode::BadChoice),
+            ("commission now", ErrorCode::BadChoice),
+            ("commission status now", ErrorCode::ExtraArgument),
             ("cal all 10", ErrorCode::BadChoice),
             ("scene Demo", ErrorCode::BadName),
             ("scene none", ErrorCode::BadName),

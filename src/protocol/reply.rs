@@ -146,6 +146,8 @@ pub fn format_ack(command: &Command, out: &mut StringView) -> Result<(), FormatE
         Command::Telemetry { rate_hz } => reply.uint("telemetry_hz", u64::from(*rate_hz)),
         Command::TelemetryOff => reply.word("telemetry_hz", "off"),
         Command::Help => reply.list("commands", &KEYWORDS),
+        Command::Commission => reply.word("commission", "started"),
+        Command::CommissionStatus => reply,
         Command::Version
         | Command::Status
         | Command::Faults

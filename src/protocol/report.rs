@@ -244,7 +244,7 @@ mod tests {
         assert_eq!(
             out,
             "ok commands=version,status,faults,target,scene,start,stop,freq,tare,cal,clear,\
-             telemetry,save,load,defaults,log,help\n"
+             telemetry,save,load,defaults,log,help,commission\n"
         );
     }
 

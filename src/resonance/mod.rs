@@ -64,6 +64,7 @@ mod follow;
 mod lockin;
 mod motional;
 mod phasor;
+mod ringdown;
 mod search;
 mod stack;
 mod sweep;
@@ -80,6 +81,11 @@ pub use follow::{
 pub use lockin::{Demodulated, LockIn, LockInConfig, MAX_WINDOW_SAMPLES};
 pub use motional::{ClampedCapacitance, MAX_DETUNING, detuning};
 pub use phasor::{Angle, Phasor, Polar};
+pub use ringdown::{
+    MIN_RING_DOWN_POINTS, MIN_RING_DOWN_START_LSB, RING_DOWN_FLOOR_LSB,
+    RING_DOWN_SPAN_TIME_CONSTANTS, RingDownError, RingDownFit, fit_ring_down, group_amplitude_lsb,
+    group_amplitude_squared,
+};
 pub use search::{Lock, Search, SearchConfig, SearchSettings, SearchStep};
 pub use stack::{StackModel, StackSettings};
 pub use sweep::{Sweep, SweepPlan, SweepPoint, SweepProgress, SweepResult};

@@ -94,6 +94,10 @@ pub struct Scene<'a> {
     pub criteria: &'a [Criterion],
     /// What the scene contains, for choosing the cheapest adequate model variant.
     pub contents: Contents,
+    /// The run uses commissioned values (`commission = true`): before it, the firmware's
+    /// `commission` ([`crate::commission`]) measures f0, Q and mu0 on the simulated rig, and the
+    /// controller runs on them instead of the declared `transducer` and `controller` values.
+    pub commission: bool,
 }
 
 impl Scene<'_> {

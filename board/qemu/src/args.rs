@@ -8,6 +8,8 @@
 //!   counts and the CPU load can be printed in instructions as well as in time;
 //! - `flash=PATH`: keep the settings in the host file PATH (the emulated flash, `flash.rs`;
 //!   created erased when missing); without it there is no settings flash;
+//! - `commission`: run the scene as if it had `commission = true` (the firmware's `commission`
+//!   measures f0, Q and mu0 on the simulated rig first; the run uses them);
 //! - `cut=N`: cut the power (exit at once, status 4) just before the N+1-th flash word
 //!   program or page erase of this run, for the power-cut test.
 
@@ -31,6 +33,8 @@ pub struct Args {
     pub flash: Option<&'static str>,
     /// Flash operations before the power is cut, if asked.
     pub cut: Option<u32>,
+    /// Commission before the run (`commission = true`).
+    pub commission: bool,
 }
 
 /// Reads and parses the arguments; an unknown word is an error naming it.
@@ -54,11 +58,14 @@ fn parse(text: &'static str) -> Result<Args, &'static str> {
         icount_shift: None,
         flash: None,
         cut: None,
+        commission: false,
     };
     // The first word is the kernel's file name.
     for word in text.split_ascii_whitespace().skip(1) {
         if word == "serve" {
             args.serve = true;
+        } else if word == "commission" {
+            args.commission = true;
         } else if let Some(name) = word.strip_prefix("scene=") {
             args.scene = name;
         } else if let Some(path) = word.strip_prefix("flash=") {

@@ -149,6 +149,17 @@ async fn supervisor_task(args: Args, control_spawner: SendSpawner) {
         .and_then(|booted| booted.record.scene)
         .and_then(|name| sonolube::scene::builtin::find(name.as_str()))
         .unwrap_or(home);
+    // `commission`: the scene as if it had `commission = true`, in a static (the rig keeps
+    // `'static` scenes).
+    static COMMISSIONED: StaticCell<sonolube::scene::Scene<'static>> = StaticCell::new();
+    let scene: &'static sonolube::scene::Scene<'static> = if args.commission {
+        COMMISSIONED.init(sonolube::scene::Scene {
+            commission: true,
+            ..*scene
+        })
+    } else {
+        scene
+    };
     let mode = if args.serve {
         Mode::Operated
     } else {

@@ -29,21 +29,36 @@ pub struct SimulatedRig {
     /// No command has changed the loop since it was built: settings for its scene go straight
     /// into it, without building another.
     pristine: bool,
+    /// `run` is the scene's simulated rig, commissioning; the scene's run follows.
+    commissioning: bool,
 }
 
 impl SimulatedRig {
     /// The rig of `scene`: playing its script ([`Mode::Scripted`]) or under the console
     /// ([`Mode::Operated`]).
+    ///
+    /// A scripted scene with `commission = true` starts on its simulated rig with `commission`
+    /// given ([`sonolube_sim::start_rig_commission`]): the firmware's control loop runs the
+    /// sequence period by period, then the scene's run is built on the measured values
+    /// ([`ClosedLoop::with_commissioned`]), the same as the host's `commission_rig` and
+    /// `ClosedLoop::new`.
     pub fn new(scene: &'static Scene<'static>, mode: Mode) -> Result<Self, SimError> {
-        let run = match mode {
+        let commissioning = mode == Mode::Scripted && scene.commission;
+        let rig_scene = sonolube_sim::rig_scene(scene);
+        let mut run = match mode {
+            Mode::Scripted if commissioning => ClosedLoop::operated(&rig_scene)?,
             Mode::Scripted => ClosedLoop::new(scene)?,
             Mode::Operated => ClosedLoop::operated(scene)?,
         };
+        if commissioning {
+            sonolube_sim::start_rig_commission(&mut run)?;
+        }
         Ok(Self {
             home: scene,
             scene,
             run,
             pristine: true,
+            commissioning,
         })
     }
 
@@ -72,6 +87,82 @@ impl SimulatedRig {
                 station.model().kind()
             ),
         }
+    }
+
+    /// After a commissioning period: when the sequence has ended, the scene's run on the
+    /// measured values replaces the rig (the watchdog fed on either side of the build, as for
+    /// `load`); a refusal ends the run as a failure.
+    fn after_commissioning_period(&mut self) {
+        let Some(outcome) = sonolube_sim::rig_commission_outcome(&self.run) else {
+            return;
+        };
+        self.commissioning = false;
+        let scene = self.scene;
+        let built = outcome.and_then(|result| {
+            crate::watchdog::feed();
+            let built = time_driver::exclude(|| {
+                ClosedLoop::with_commissioned(
+                    scene,
+                    sonolube::variant::select(scene),
+                    sonolube_sim::COMMISSIONED,
+                    Some(result),
+                )
+            });
+            crate::watchdog::feed();
+            built
+        });
+        match built {
+            Ok(run) => {
+                self.run = run;
+                drive::set(sonolube::fx::Q1_31::ZERO);
+                self.log_commissioned();
+            }
+            Err(error) => {
+                defmt::error!("scene {=str}: commissioning: {}", scene.name, error);
+                crate::exit::exit(crate::exit::FAULT);
+            }
+        }
+    }
+
+    /// Logs what commissioning measured before the run (scenes with `commission = true`), as
+    /// values and as `f64` bits (which `scripts/test` compares with the host's).
+    pub fn log_commissioned(&self) {
+        let Some(r) = self.run.commissioned() else {
+            return;
+        };
+        defmt::info!(
+            "scene {=str}: commissioned f0 {=f64} +- {=f64} Hz, Q {=f64} +- {=f64}, tau {=f64} +- {=f64} s, mu0 {=f64} +- {=f64}, {=u32} ring-down points",
+            self.scene.name,
+            r.resonance_hz.value,
+            r.resonance_hz.standard_error,
+            r.quality_factor.value,
+            r.quality_factor.standard_error,
+            r.time_constant_s.value,
+            r.time_constant_s.standard_error,
+            r.natural_coefficient.value,
+            r.natural_coefficient.standard_error,
+            r.ring_down_points
+        );
+        let bits =
+            |m: sonolube::commission::Measured| (m.value.to_bits(), m.standard_error.to_bits());
+        let (f0, q, tau, mu0) = (
+            bits(r.resonance_hz),
+            bits(r.quality_factor),
+            bits(r.time_constant_s),
+            bits(r.natural_coefficient),
+        );
+        defmt::info!(
+            "scene {=str}: commissioned bits f0 {=u64:x} {=u64:x} q {=u64:x} {=u64:x} tau {=u64:x} {=u64:x} mu0 {=u64:x} {=u64:x}",
+            self.scene.name,
+            f0.0,
+            f0.1,
+            q.0,
+            q.1,
+            tau.0,
+            tau.1,
+            mu0.0,
+            mu0.1
+        );
     }
 
     /// The judge's summary of the steps so far.
@@ -168,6 +259,10 @@ impl Persistent for SimulatedRig {
     fn latched_fault(&self) -> Option<Reason> {
         self.run.controller().fault()
     }
+
+    fn commission(&self) -> sonolube::station::CommissionReport {
+        self.run.station().commission_report()
+    }
 }
 
 impl ControlLoop for SimulatedRig {
@@ -185,6 +280,9 @@ impl ControlLoop for SimulatedRig {
         drive::set(output.amplitude);
         let cycles = time_driver::cycles().saturating_sub(start);
         let record = time_driver::exclude(|| self.run.finish_step())?;
+        if self.commissioning {
+            self.after_commissioning_period();
+        }
         Some(
             Snapshot::new(
                 &output,

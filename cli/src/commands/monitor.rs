@@ -7,6 +7,7 @@
 //! sonolube monitor --connect unix:/tmp/uart.sock -c "target coef 0.15" -c start -c "wait 50"
 //! sonolube monitor --connect serial:/dev/ttyACM0 --script session.txt --csv run.csv --svg run.svg
 //! sonolube monitor --connect unix:/tmp/uart.sock --acceptance --csv target/monitor/acceptance.csv
+//! sonolube monitor --connect unix:/tmp/uart.sock --commission
 //! ```
 //!
 //! Exit status: 0 when every reply was `ok` (and the acceptance test passed, when asked); 1 when
@@ -22,8 +23,8 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use crate::monitor::{
-    AcceptanceConfig, Endpoint, Link, LinkOptions, Session, Step, parse_script, parse_step,
-    run_acceptance, run_steps, telemetry_csv, telemetry_svg,
+    AcceptanceConfig, CommissionOutcome, Endpoint, Link, LinkOptions, Session, Step, parse_script,
+    parse_step, run_acceptance, run_commission, run_steps, telemetry_csv, telemetry_svg,
 };
 
 const USAGE: &str = "\
@@ -42,6 +43,9 @@ interface after the commands.
   --script FILE            send FILE's lines: one command per line, blank lines and lines
                            starting with '#' skipped, and 'wait MS': MS ms of firmware time
                            (telemetry t_us) while telemetry is on, of wall time while it is off
+  --commission             after the commands: 'commission' (drive off, contact loaded and
+                           sliding), then 'commission status' every 20 ms until it ends; exit 1
+                           unless it is done (f0, Q, tau, mu0 with their standard errors)
   --acceptance             run the acceptance test (6 checks, 'monitor acceptance: N passed,
                            M failed'); exit 1 unless all pass
   --csv FILE               write every telemetry record: header row, one column per field
@@ -69,6 +73,8 @@ struct Options {
     endpoint: Endpoint,
     steps: Vec<Step>,
     acceptance: bool,
+    /// Run `commission` after the commands and wait for its result.
+    commission: bool,
     csv: Option<PathBuf>,
     svg: Option<PathBuf>,
     allow_errors: bool,
@@ -142,6 +148,21 @@ pub fn run(args: &[String]) -> ExitCode {
             eprintln!("sonolube monitor: {error}");
             failed = true;
             connected = false;
+        }
+    }
+    if options.commission && connected {
+        match run_commission(&mut link, &mut out) {
+            Ok(CommissionOutcome::Done(_)) => {}
+            Ok(CommissionOutcome::Refused(_)) => failed = true,
+            Ok(CommissionOutcome::TimedOut) => {
+                let _ = writeln!(out, "# commissioning did not end");
+                failed = true;
+            }
+            Err(error) => {
+                eprintln!("sonolube monitor: {error}");
+                failed = true;
+                connected = false;
+            }
         }
     }
     if options.acceptance {
@@ -275,6 +296,7 @@ fn parse_args(args: &[String]) -> Result<Option<Options>, String> {
     let mut endpoint = None;
     let mut steps = Vec::new();
     let mut acceptance = false;
+    let mut commission = false;
     let mut csv = None;
     let mut svg = None;
     let mut allow_errors = false;
@@ -286,6 +308,7 @@ fn parse_args(args: &[String]) -> Result<Option<Options>, String> {
         match flag {
             "-h" | "--help" => return Ok(None),
             "--acceptance" => acceptance = true,
+            "--commission" => commission = true,
             "--allow-errors" => allow_errors = true,
             "--connect"
             | "-c"
@@ -343,6 +366,7 @@ fn parse_args(args: &[String]) -> Result<Option<Options>, String> {
         endpoint,
         steps,
         acceptance,
+        commission,
         csv,
         svg,
         allow_errors,

@@ -5,7 +5,7 @@
 //! per scene: its verdicts, then the model it ran.
 //!
 //! ```text
-//! sonolube scene NAME [--out DIR] [--file PATH.toml]
+//! sonolube scene NAME [--out DIR] [--file PATH.toml] [--commission]
 //! sonolube scene --all [--out DIR]
 //! sonolube scene NAME|--all --seeds N|A-B [--plot PATH.svg]
 //! sonolube scene NAME --mismatch|--envelope|--noise|--resonators [--seeds N|A-B] [--out DIR]
@@ -15,6 +15,12 @@
 //! The mismatch grid runs `freq auto` before `start` (the search, then the tracker, on the
 //! transducer's complex envelope): a resonance known only to +-0.5 % must be followed.
 //! `--pinned` holds the drive at the scene's frequency instead.
+//!
+//! `--commission` runs the scene as if it had `commission = true`: the firmware's `commission`
+//! first measures f0, Q and mu0 on the simulated rig ([`sonolube_sim::commission_rig`]), the
+//! run's controller uses them, and the report starts with what was measured (against the
+//! declared and the true values) and the same values as `f64` bits, which the QEMU check
+//! compares with the firmware's.
 //!
 //! `--seeds`, `--mismatch`, `--envelope`, `--noise` and `--resonators` are the robustness sweeps ([`robust`]):
 //! many runs over every core, a table per criterion (pass rate, percentiles, worst run), a
@@ -74,7 +80,7 @@ use sonolube_sim::{ClosedLoop, RunSummary};
 pub use csv::csv;
 pub use report::{model_line, model_name, short};
 
-const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml] [--model VARIANT]\n       \
+const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml] [--model VARIANT] [--commission]\n       \
                      sonolube scene --all [--out DIR]\n       \
                      sonolube scene NAME|--all --seeds N|A-B [--plot PATH.svg]\n       \
                      sonolube scene NAME --mismatch|--envelope|--noise|--resonators [--seeds N|A-B] [--out DIR]\n       \
@@ -94,6 +100,7 @@ pub fn run(args: &[String]) -> ExitCode {
     let mut plot = None;
     let mut sweep = None;
     let mut pinned = false;
+    let mut commission = false;
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
         match arg.as_str() {
@@ -128,6 +135,7 @@ pub fn run(args: &[String]) -> ExitCode {
                 }
             }
             "--pinned" => pinned = true,
+            "--commission" => commission = true,
             "-h" | "--help" => {
                 print!("{USAGE}");
                 return ExitCode::SUCCESS;
@@ -192,6 +200,11 @@ pub fn run(args: &[String]) -> ExitCode {
         },
         (None, None) => return usage("a scene NAME, --file or --all is needed"),
     };
+    // `--commission`: as if the scene had `commission = true`.
+    let scene = Scene {
+        commission: scene.commission || commission,
+        ..scene
+    };
     if robust {
         if forced.is_some() {
             return usage("--model goes with a single run, not a sweep");
@@ -214,6 +227,51 @@ pub fn run(args: &[String]) -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// What commissioning measured before the run, against the scene's declared and true values,
+/// and the same values as `f64` bits (the QEMU check compares them with the firmware's).
+fn commissioned_lines(scene: &Scene<'_>, r: &sonolube::commission::CommissionResult) -> String {
+    let speed = scene
+        .sliding_velocity_m_per_s
+        .first()
+        .map_or(0.0, |p| p.value.abs());
+    let t = &scene.transducer;
+    let mut text = format!(
+        "  commissioned: f0 {:.2} +- {:.2} Hz (declared {}, true {}), Q {:.2} +- {:.2} \
+         (declared {}, true {}), tau {:.4} +- {:.4} ms from {} ring-down points, mu0 {:.5} +- \
+         {:.5} (declared {}, true {}), cell zeros {:.4} N normal, {:.4} N tangential\n",
+        r.resonance_hz.value,
+        r.resonance_hz.standard_error,
+        t.resonance_hz,
+        t.resonance_hz,
+        r.quality_factor.value,
+        r.quality_factor.standard_error,
+        t.quality_factor,
+        t.quality_factor,
+        r.time_constant_s.value * 1e3,
+        r.time_constant_s.standard_error * 1e3,
+        r.ring_down_points,
+        r.natural_coefficient.value,
+        r.natural_coefficient.standard_error,
+        scene.controller.natural_coefficient(speed),
+        scene.plant.natural_coefficient(speed),
+        r.normal.zero_n,
+        r.tangential.zero_n,
+    );
+    let bits = [
+        r.resonance_hz,
+        r.quality_factor,
+        r.time_constant_s,
+        r.natural_coefficient,
+    ]
+    .map(|m| format!("{:x} {:x}", m.value.to_bits(), m.standard_error.to_bits()));
+    let _ = writeln!(
+        text,
+        "  commissioned bits f0 {} q {} tau {} mu0 {}",
+        bits[0], bits[1], bits[2], bits[3]
+    );
+    text
 }
 
 fn usage(problem: &str) -> ExitCode {
@@ -314,7 +372,11 @@ pub fn run_forced(
     std::fs::write(&csv_path, csv(&records)).map_err(|e| format!("{}: {e}", csv_path.display()))?;
     std::fs::write(&svg_path, svg(scene, &summary, &records))
         .map_err(|e| format!("{}: {e}", svg_path.display()))?;
-    let mut text = report(scene, station, &summary, &records);
+    let mut text = String::new();
+    if let Some(result) = sim.commissioned() {
+        text.push_str(&commissioned_lines(scene, result));
+    }
+    text.push_str(&report(scene, station, &summary, &records));
     let _ = writeln!(
         text,
         "  wrote {} and {}",

@@ -15,6 +15,7 @@
 
 pub mod acceptance;
 mod checks;
+mod commission;
 mod csv;
 mod endpoint;
 mod figure;
@@ -27,6 +28,7 @@ mod telemetry_log;
 mod verdicts;
 
 pub use acceptance::{AcceptanceConfig, AcceptanceReport, Check, run_acceptance};
+pub use commission::{CommissionOutcome, MAX_POLLS, POLL_MS, run_commission};
 pub use csv::{CSV_HEADER, telemetry_csv};
 pub use endpoint::{Connection, DEFAULT_BAUD, Endpoint, connect};
 pub use figure::telemetry_svg;

@@ -225,3 +225,55 @@ fn lock_in_demodulation_of_the_sampled_current_recovers_the_phasor() {
     // Above resonance the motional current lags.
     assert!(phasor.motional_phase_rad < 0.0);
 }
+
+/// The stack with the complex envelope, whose current the boards' sense samples.
+fn sampled_stack(resonance_hz: f64, quality_factor: f64) -> ResonantTransducer {
+    let stack = Transducer {
+        resonance_hz,
+        quality_factor,
+        drive_hz: resonance_hz,
+        shift: sonolube::scene::ResonanceShift {
+            bvd_envelope: true,
+            ..sonolube::scene::ResonanceShift::NONE
+        },
+        ..STACK
+    };
+    ResonantTransducer::with_shift(&stack, &ACTUATOR, 7)
+}
+
+#[test]
+fn the_sampled_current_rings_down_with_tau_q_over_pi_f0() {
+    // Commissioning's measurement (`sonolube::commission`): drive half full scale at f0 for
+    // ten time constants, then off; the lock-in amplitude of each group of four current
+    // samples decays as exp(-t / tau), tau = Q / (pi f0).
+    for (f0, q) in [(40_000.0f64, 100.0f64), (28_000.0, 300.0), (50_000.0, 30.0)] {
+        let mut transducer = sampled_stack(f0, q);
+        let tau = q / (core::f64::consts::PI * f0);
+        let substep_s = 0.25 / f0 as f32;
+        let steps = libm::ceil(10.0 * tau / f64::from(substep_s)) as u32;
+        for _ in 0..steps {
+            transducer.advance(0.5, f0 as f32, substep_s);
+            transducer.take_current_codes();
+        }
+        let mut groups = std::vec::Vec::new();
+        let mut codes = std::vec::Vec::new();
+        for _ in 0..libm::ceil(4.0 * tau * f0 * 4.0) as u32 {
+            transducer.advance(0.0, f0 as f32, substep_s);
+            let (taken, count) = transducer.take_current_codes();
+            codes.extend_from_slice(&taken[..count]);
+        }
+        for group in codes.chunks_exact(4) {
+            let squared = sonolube::resonance::group_amplitude_squared([
+                group[0], group[1], group[2], group[3],
+            ]);
+            groups.push(sonolube::resonance::group_amplitude_lsb(squared));
+        }
+        let fit =
+            sonolube::resonance::fit_ring_down(groups.iter().copied(), 4.0 / f0).expect("fits");
+        let error = (fit.time_constant_s - tau).abs();
+        assert!(
+            error < 4.0 * fit.time_constant_se_s && fit.time_constant_se_s < 0.03 * tau,
+            "f0 {f0} Q {q}: {fit:?} against tau {tau}"
+        );
+    }
+}
