@@ -92,6 +92,10 @@ pub const STEADY_GAINS: (f64, f64) = (0.1, 300.0);
 /// take over within the boost's 3 ms, so the steady RMS error does not see the faster set.
 pub const FAST_GAINS: (f64, f64) = (0.3, 6_000.0);
 
+// The scene schema's control-rate range (one source, `CONTROL_RATE_RANGE_HZ`) starts where
+// the fast integral step `ki T` reaches 1: a scene the loader accepts is one the gains accept.
+const _: () = assert!(FAST_GAINS.1 <= crate::scene::CONTROL_RATE_RANGE_HZ.0);
+
 /// The controller's settings for `scene`: [`Settings::REFERENCE`] with the tuning's
 /// departures ([`FORCE_FILTER_HZ`] for both force filters, [`VELOCITY_FILTER_HZ`],
 /// [`NATURAL_PRIOR_WEIGHT`], [`SLIDING_DEBOUNCE_S`], [`NATURAL_LEARN_S`], [`STEADY_GAINS`],
@@ -218,6 +222,24 @@ mod tests {
         assert!((s.tangential_force_range_n - 2.2).abs() < 1e-12);
         assert_eq!(s.velocity_range_m_s, 5.0);
         assert!(crate::control::Config::new(&s).is_ok());
+    }
+
+    #[test]
+    fn the_controller_accepts_exactly_the_schemas_control_rates() {
+        // Issue 26: the schema allowed 1e3 Hz while the controller refused below 6e3 Hz. Both
+        // ends of the one range build; just below its low end the fast PI step is refused.
+        let scene = find("reference").expect("built in");
+        let at = |rate_hz: f64| {
+            let scene = crate::scene::Scene {
+                control_rate_hz: rate_hz,
+                ..*scene
+            };
+            crate::control::Config::new(&controller_settings(&scene))
+        };
+        let (low, high) = crate::scene::CONTROL_RATE_RANGE_HZ;
+        assert!(at(low).is_ok());
+        assert!(at(high).is_ok());
+        assert!(at(low * (1.0 - 1e-9)).is_err());
     }
 
     #[test]
