@@ -122,6 +122,19 @@ pub struct Finding {
     pub cause: Cause,
 }
 
+impl Finding {
+    /// What fails, in a few words (at most [`crate::protocol::MAX_REASON_LEN`] bytes), for an
+    /// `err` reply; the numbers are in the [`fmt::Display`] text.
+    pub const fn summary(&self) -> &'static str {
+        match self.cause {
+            Cause::TargetOutOfReach { .. } => "the target is beyond the drive's reach",
+            Cause::NoSliding { .. } => "the speed is below the sliding threshold",
+            Cause::Noise { .. } => "the cells' noise exceeds the accuracy band",
+            Cause::Model(_) => "the controller's model fails over the scene",
+        }
+    }
+}
+
 impl fmt::Display for Finding {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}: ", self.severity.word())?;

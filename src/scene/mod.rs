@@ -23,7 +23,7 @@ pub mod builtin;
 pub mod feasibility;
 mod table;
 
-pub use builtin::{SCENES, find};
+pub use builtin::{SCENE_NAMES, SCENES, find};
 // The plain scene types, defined once in `sonolube-scene-types` and shared with the scene-file
 // loader (`scene-toml`), which reads them on the host and writes them for the build script.
 pub use sonolube_scene_types::CONTROL_RATE_RANGE_HZ;
