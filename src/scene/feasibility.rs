@@ -177,7 +177,7 @@ impl fmt::Display for Finding {
                 threshold_m_per_s,
             } => write!(
                 f,
-                "{}: from {from_s} s to {to_s} s the speed is at most {top_speed_m_per_s} m/s, \
+                "{}: from {from_s} s to {to_s} s the speed is at most {top_speed_m_per_s:.6} m/s, \
                  {:.0} % of the time below the sliding threshold {threshold_m_per_s} m/s: the \
                  loop does not run without sliding",
                 self.field,
