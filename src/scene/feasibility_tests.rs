@@ -153,7 +153,10 @@ fn a_speed_below_the_sliding_threshold_is_refused() {
         ..scene
     };
     let message = refused_at(&judge(&scene), "profiles.sliding_velocity_m_per_s");
-    assert!(message.contains("at most 0.000800 m/s") && message.contains("0.001 m/s"), "{message}");
+    assert!(
+        message.contains("at most 0.000800 m/s") && message.contains("0.001 m/s"),
+        "{message}"
+    );
 }
 
 #[test]
