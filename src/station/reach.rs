@@ -2,8 +2,8 @@
 //! the full drive reaches now, and whether the drive frequency is far from the resonance.
 //!
 //! - **target-unreachable**: the drive has been at its limit (the actuator ceiling, or the
-//!   model's full amplitude) for a whole watch window with the loop's error not falling: not
-//!   halved over the window. The window is three times the time the drive takes to act on the
+//!   model's full amplitude) for a whole watch window with the tracking error (measured friction
+//!   ratio against the target's) not falling: not halved over the window. The window is three times the time the drive takes to act on the
 //!   measured friction: the transducer's envelope, the cell's lag and the force filter's time
 //!   constant in series (4.5 ms in the reference scene). A reachable target at the limit halves
 //!   its error well within it (the envelope reaches 95 % in three time constants); an
@@ -67,7 +67,18 @@ impl ReachWatch {
             *self = Self::new_like(self);
             return;
         }
-        let error = output.error.to_bits().unsigned_abs();
+        // The tracking error, measured ratio against the target's (the PI's own error is the
+        // model's prediction against the measurement: near zero at the limit, whatever the
+        // target).
+        let Some(target) = output.target_ratio else {
+            *self = Self::new_like(self);
+            return;
+        };
+        let error = output
+            .measured_ratio
+            .to_bits()
+            .wrapping_sub(target.to_bits())
+            .unsigned_abs();
         if self.periods == 0 {
             self.error_at_start = error;
         }
@@ -177,6 +188,7 @@ mod tests {
     use super::*;
     use crate::control::Saturation;
 
+    /// An output at (or off) the limit whose measured ratio is `error` above a target of 0.2.
     fn output(at_limit: bool, error: f64) -> Output {
         // A real step's output, then the fields the watch reads.
         let scene = crate::scene::find("reference").expect("built in");
@@ -196,7 +208,8 @@ mod tests {
             actuator: at_limit,
             ..output.saturation
         };
-        output.error = Q2_30::from_f64_saturating(error).value;
+        output.target_ratio = Some(Q2_30::from_f64_saturating(0.2).value);
+        output.measured_ratio = Q2_30::from_f64_saturating(0.2 + error).value;
         output
     }
 
@@ -215,12 +228,12 @@ mod tests {
     fn a_limit_with_a_stuck_error_is_unreachable_until_the_drive_leaves_it() {
         let mut watch = ReachWatch::new(1e-3, 1e-4);
         for _ in 0..9 {
-            watch.update(&output(true, -0.3));
+            watch.update(&output(true, 0.3));
             assert_eq!(watch.state(), ReachState::Ok);
         }
-        watch.update(&output(true, -0.3));
+        watch.update(&output(true, 0.3));
         assert_eq!(watch.state(), ReachState::TargetUnreachable);
-        watch.update(&output(false, -0.3));
+        watch.update(&output(false, 0.3));
         assert_eq!(watch.state(), ReachState::Ok);
     }
 
