@@ -29,7 +29,7 @@ use crate::control::{
 };
 use crate::drive::{Amplitude, Frequency, TimerClock};
 use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
-use crate::model::{AnyModel, ModelError};
+use crate::model::{AnyModel, FrictionModel, ModelError};
 use crate::resonance::{ResonanceLoop, ResonanceReport, ResonanceSettings, StackSettings};
 use core::fmt::Write;
 
@@ -43,6 +43,7 @@ mod commission;
 
 pub use commission::CommissionReport;
 use commission::CommissionState;
+mod reach;
 
 /// What a board gives the station each period.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -102,7 +103,8 @@ pub struct Station {
     selection: Option<Selection>,
     controller: Controller,
     /// The settings the controller was built from; the gains are recomputed from them with
-    /// the cells' measured noise after a tare ([`Station::tune_to_cells`]).
+    /// the cells' measured noise after a tare ([`Station::tune_to_cells`]), and commissioning
+    /// replaces the values it measures.
     settings: Settings,
     normal: SensorChannel,
     tangential: SensorChannel,
@@ -120,14 +122,31 @@ pub struct Station {
     /// The board feeds current samples ([`Self::enable_current_sense`]): `freq auto` is
     /// possible.
     current_sense: bool,
+    /// Why `freq auto` is refused while `current_sense` is false: the board's reason by
+    /// default, the scene's when the board said so ([`Self::no_current_sense_in_scene`]).
+    no_current_reason: &'static str,
     /// The drive amplitude the station returned last (what the drive applies over the
     /// period whose current samples come next).
     applied: Amplitude,
-    /// The controller's settings (commissioning replaces the measured ones).
-    settings: Settings,
     /// The last `commission` ([`crate::commission`]).
     commission: CommissionState,
+    /// Feasibility while running (issue 26): the watch over the drive's limit, the last
+    /// estimate and learned natural coefficient, the scene's nominal resonance, and the
+    /// warning of the last `target`.
+    reach: reach::ReachWatch,
+    last_estimate: Option<(crate::control::FrictionEstimate, Q2_30)>,
+    nominal_resonance_hz: f64,
+    quality_factor: f64,
+    controller_mu: f64,
+    target_warning: Option<crate::protocol::Target>,
 }
+
+/// `freq auto` refused: the board samples no drive current.
+const NO_CURRENT_ON_BOARD: &str = "this board does not sample the drive current";
+
+/// `freq auto` refused: the scene's plant gives no drive current (at most
+/// [`crate::protocol::MAX_REASON_LEN`] bytes).
+const NO_CURRENT_IN_SCENE: &str = "the scene has no current sensing (bvd_envelope = false)";
 
 /// The current sense the station assumes for the resonance loop: the NUCLEO-G474RE's
 /// (25 mOhm shunt, INA240A1 at 20 V/V, 3.3 V converter span: 6.6 A per full scale; the QEMU
@@ -224,9 +243,15 @@ impl Station {
             auto_armed: false,
             start_pending: false,
             current_sense: false,
+            no_current_reason: NO_CURRENT_ON_BOARD,
             applied: Amplitude::ZERO,
-            settings: *settings,
             commission: CommissionState::Never,
+            reach: reach::ReachWatch::new(reach::ReachWatch::window_s(settings), settings.period_s),
+            last_estimate: None,
+            nominal_resonance_hz: scene.transducer.resonance_hz,
+            quality_factor: scene.transducer.quality_factor,
+            controller_mu: scene.controller.mu,
+            target_warning: None,
         })
     }
 
@@ -234,6 +259,14 @@ impl Station {
     /// auto` is refused (`unavailable`): a search without samples would never end.
     pub fn enable_current_sense(&mut self) {
         self.current_sense = true;
+    }
+
+    /// Declares that the board would sample the drive current but the scene gives none (a
+    /// simulated plant without the complex envelope, `transducer.shift.bvd_envelope =
+    /// false`): `freq auto` is then refused naming the scene, not the board (issue 26).
+    pub fn no_current_sense_in_scene(&mut self) {
+        self.current_sense = false;
+        self.no_current_reason = NO_CURRENT_IN_SCENE;
     }
 
     /// The current samples (12-bit current-sense codes, mid-scale zero) taken synchronously
@@ -334,6 +367,8 @@ impl Station {
             tangential_force,
             sample.sliding_velocity_m_per_s,
         );
+        self.reach.update(&output);
+        self.last_estimate = Some((output.estimate, output.natural_coefficient));
         Control {
             output,
             sensor_fault,
@@ -365,7 +400,11 @@ impl Station {
         }
         match *command {
             Command::Commission => self.start_commission(command),
-            Command::Target(target) => self.controller.set_target(target).map_err(refused),
+            Command::Target(target) => {
+                self.controller.set_target(target).map_err(refused)?;
+                self.target_warning = self.beyond_reach(target);
+                Ok(())
+            }
             Command::Start if self.auto_armed => {
                 // Refused for the controller's reasons (no target, fault latched) before
                 // anything changes; accepted, the search runs first and the friction loop
@@ -397,7 +436,7 @@ impl Station {
                 if !self.current_sense {
                     return Err(ProtocolError::Unavailable {
                         command: command.keyword(),
-                        reason: "this board does not sample the drive current",
+                        reason: self.no_current_reason,
                     });
                 }
                 let resonance = self.resonance.as_mut().ok_or(ProtocolError::Unavailable {
@@ -537,6 +576,69 @@ impl Station {
                 state,
             }),
         }
+    }
+
+    /// The reach fields of `status` and telemetry: whether the target is out of reach (with
+    /// the value the full drive reaches now) and whether the drive is far from the resonance.
+    pub fn run_reach(&self) -> crate::protocol::RunReach {
+        let state = self.reach.state();
+        let reachable = match (state, self.controller.target()) {
+            (crate::protocol::ReachState::TargetUnreachable, Some(target)) => {
+                self.beyond_reach(target)
+            }
+            _ => None,
+        };
+        crate::protocol::RunReach {
+            state,
+            reachable,
+            resonance: Some(reach::distance(self.detuning())),
+        }
+    }
+
+    /// With the last `target` accepted: the value the full drive reaches now when the target
+    /// is beyond it (`ok ... warning=beyond-reach reachable=...`), else `None`.
+    pub fn target_warning(&self) -> Option<crate::protocol::Target> {
+        self.target_warning
+    }
+
+    /// The drive's detuning from the resonance, half-bandwidths: the resonance loop's
+    /// measurement where there is one, else from the scene's nominal f0.
+    fn detuning(&self) -> f64 {
+        match self.resonance().and_then(|report| report.detuning) {
+            Some(measured) if self.current_sense => reach::measured_detuning(measured),
+            _ => reach::nominal_detuning(
+                f64::from(self.drive_hz),
+                self.nominal_resonance_hz,
+                self.quality_factor,
+            ),
+        }
+    }
+
+    /// The value the model says the drive reaches now when `target` asks for more: see
+    /// [`reach::beyond_reach`].
+    fn beyond_reach(&self, target: crate::protocol::Target) -> Option<crate::protocol::Target> {
+        let (estimate, natural) = self.last_estimate?;
+        let ceiling = self.controller.config().limit().max_amplitude.to_f64();
+        let load_scale = if self.model.load_enters_as_coulomb_force() && self.controller_mu > 0.0 {
+            natural.to_f64() / self.controller_mu
+        } else {
+            1.0
+        };
+        reach::beyond_reach(
+            &self.model,
+            target,
+            &estimate,
+            natural,
+            ceiling * reach::detuning_gain(self.detuning()),
+            load_scale,
+        )
+    }
+
+    /// Whether `scene` (the one this station was built for) can work with this station's
+    /// controller model: [`crate::scene::feasibility::check`]. A board calls it at `scene`
+    /// and refuses a scene with a refusal (issue 26).
+    pub fn feasibility(&self, scene: &Scene<'_>) -> crate::scene::feasibility::Feasibility {
+        crate::scene::feasibility::check(scene, &self.model)
     }
 
     /// The supervisor's present state (`tuning` while commissioning runs).

@@ -144,7 +144,13 @@ async fn execute(command: &Command, identity: &Identity, out: &mut String<LINE_C
                     crate::persist::take_reply(out);
                     return !out.is_empty();
                 }
-                Ok(()) => format_ack(command, view),
+                Ok(()) => match command {
+                    Command::Target(target) => {
+                        let warning = link::TARGET_WARNING.lock(core::cell::Cell::get);
+                        sonolube::protocol::format_target_ack(target, warning.as_ref(), view)
+                    }
+                    _ => format_ack(command, view),
+                },
                 Err(error) => format_error(&error, view),
             }
         }

@@ -67,6 +67,11 @@ pub trait ControlLoop {
     fn execute(&mut self, command: &Command) -> Result<(), ProtocolError>;
     /// Latches the controller's overrun fault.
     fn trip_overrun(&mut self);
+    /// After an accepted `target`: the value the full drive reaches now when the target is
+    /// beyond it (the `warning=beyond-reach` of the reply); `None` by default.
+    fn target_warning(&self) -> Option<sonolube::protocol::Target> {
+        None
+    }
 }
 
 /// What the loop measured over its run.
@@ -109,6 +114,10 @@ pub async fn run<L: ControlLoop>(control: &mut L) -> LoopStats {
         // Between two steps: at most one command per period.
         if let Ok(command) = REQUESTS.try_receive() {
             let result = control.execute(&command);
+            if result.is_ok() && matches!(command, Command::Target(_)) {
+                let warning = control.target_warning();
+                link::TARGET_WARNING.lock(|cell| cell.set(warning));
+            }
             // The console waits for each answer before it sends the next request, so the
             // depth-1 queue is empty here.
             let _ = RESPONSES.try_send(result);

@@ -47,6 +47,13 @@ pub static STEPS: AtomicU32 = AtomicU32::new(0);
 /// Telemetry rate in Hz, 0 when off.
 pub static TELEMETRY_HZ: AtomicU32 = AtomicU32::new(0);
 
+/// The warning of the last accepted `target` (the value the full drive reaches now, when the
+/// target is beyond it), set by the control task before it answers the command.
+pub static TARGET_WARNING: Mutex<
+    CriticalSectionRawMutex,
+    Cell<Option<sonolube::protocol::Target>>,
+> = Mutex::new(Cell::new(None));
+
 /// The latest snapshot.
 pub fn snapshot() -> Snapshot {
     SNAPSHOT.lock(Cell::get)

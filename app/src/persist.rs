@@ -309,4 +309,8 @@ impl<L: ControlLoop + Persistent, F: NorFlash> ControlLoop for Persisted<L, F> {
     fn trip_overrun(&mut self) {
         self.inner.trip_overrun();
     }
+
+    fn target_warning(&self) -> Option<sonolube::protocol::Target> {
+        self.inner.target_warning()
+    }
 }

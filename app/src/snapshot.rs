@@ -3,7 +3,7 @@
 
 use sonolube::control::Output;
 use sonolube::fx::{Q1_31, Q2_30, Q16_16};
-use sonolube::protocol::{Lock, LoopReading, StatusReport, Target, TelemetryRecord};
+use sonolube::protocol::{Lock, LoopReading, RunReach, StatusReport, Target, TelemetryRecord};
 
 /// The loop after a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, defmt::Format)]
@@ -24,6 +24,8 @@ pub struct Snapshot {
     /// The motional current (its phase to the voltage is the tracker's phase error; turned
     /// into degrees only for `status`); `None` when undefined.
     pub motional: Option<sonolube::resonance::Phasor>,
+    /// Whether the target is within reach, and the drive near the resonance (issue 26).
+    pub reach: RunReach,
 }
 
 impl Snapshot {
@@ -36,6 +38,7 @@ impl Snapshot {
         control_cycles: 0,
         lock: None,
         motional: None,
+        reach: RunReach::UNKNOWN,
     };
 
     /// The snapshot of a controller `output`, with the loop's other facts.
@@ -63,7 +66,14 @@ impl Snapshot {
             control_cycles,
             lock: None,
             motional: None,
+            reach: RunReach::UNKNOWN,
         }
+    }
+
+    /// This snapshot with the station's reach fields
+    /// (`sonolube::station::Station::run_reach`).
+    pub fn with_reach(self, reach: RunReach) -> Self {
+        Snapshot { reach, ..self }
     }
 
     /// This snapshot with the station's resonance report (`None`: no loop).
@@ -85,6 +95,7 @@ impl Snapshot {
             latched_fault: self.latched_fault,
             lock: self.lock.map(Lock::name),
             phase_mdeg: self.phase_mdeg(),
+            reach: self.reach,
         }
     }
 
@@ -98,6 +109,7 @@ impl Snapshot {
             lost_records: lost,
             lock: self.lock,
             phase_mdeg: self.phase_mdeg(),
+            reach: self.reach,
         }
     }
 

@@ -122,6 +122,7 @@ impl Firmware {
             lost_records: self.lost,
             lock: None,
             phase_mdeg: None,
+            reach: sonolube::protocol::RunReach::UNKNOWN,
         }
     }
 
@@ -210,6 +211,7 @@ impl Firmware {
                     latched_fault: None,
                     lock: Some("pinned"),
                     phase_mdeg: None,
+                    reach: sonolube::protocol::RunReach::UNKNOWN,
                 },
                 out,
             ),

@@ -14,7 +14,9 @@ use crate::types::{
     TargetPoint, Transducer,
 };
 
-/// Rust source defining `pub static SCENES: &[Scene<'static>]` with `scenes` in order.
+/// Rust source defining `pub static SCENES: &[Scene<'static>]` with `scenes` in order, and
+/// `pub const SCENE_NAMES: [&str; N]`, their names in the same order (a constant, so that a
+/// board lists every compiled scene and the protocol sizes its `scene list` reply for them).
 pub fn generate_rust(scenes: &[SceneDescription]) -> String {
     let mut out = String::from(
         "// Generated from scenes/*.toml by the sonolube build script (scene-toml): do not edit.\n\
@@ -25,6 +27,16 @@ pub fn generate_rust(scenes: &[SceneDescription]) -> String {
         out.push_str("    ");
         out.push_str(&scene_literal(scene));
         out.push_str(",\n");
+    }
+    out.push_str("];\n");
+    out.push_str(
+        "/// The name of every scene of [`SCENES`], in the same order (`scene list`).\n\
+         pub const SCENE_NAMES: [&str; ",
+    );
+    out.push_str(&scenes.len().to_string());
+    out.push_str("] = [");
+    for scene in scenes {
+        out.push_str(&format!("{:?}, ", scene.name));
     }
     out.push_str("];\n");
     out

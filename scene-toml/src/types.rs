@@ -5,6 +5,7 @@
 //! the host can convert one into the other without loss. Units and ranges are those of
 //! `scenes/README.md`; the loader has checked them.
 
+pub use sonolube_scene_types::CONTROL_RATE_RANGE_HZ;
 pub use sonolube_scene_types::{
     Accuracy, Actuator, ActuatorKind, Breakpoint, Channel, Contents, Criterion, FaultEvent,
     FaultKind, Horn, LoadCell, Mismatch, ModelKind, ModelSpec, Rail, ResonanceShift, RoughSurface,

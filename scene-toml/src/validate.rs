@@ -6,6 +6,7 @@ use crate::error::{Errors, SceneError};
 use crate::hardware;
 use crate::raw::{RawModel, RawScene, RawSurface};
 use crate::tables;
+use crate::types::CONTROL_RATE_RANGE_HZ;
 use crate::types::{Mismatch, ModelKind, ModelSpec, RoughSurface, SceneDescription, System};
 
 /// Control rate when the file gives none, Hz (the 10 kHz loop).
@@ -73,12 +74,20 @@ pub(crate) fn scene(raw: RawScene, errors: Errors<'_>) -> Result<SceneDescriptio
             ("seat-belt", System::SeatBelt),
         ],
     )?;
-    let control_rate_hz = errors.within(
-        "control_rate_hz",
-        raw.control_rate_hz.unwrap_or(DEFAULT_CONTROL_RATE_HZ),
-        1_000.0,
-        100_000.0,
-    )?;
+    let control_rate_hz = errors
+        .within(
+            "control_rate_hz",
+            raw.control_rate_hz.unwrap_or(DEFAULT_CONTROL_RATE_HZ),
+            CONTROL_RATE_RANGE_HZ.0,
+            CONTROL_RATE_RANGE_HZ.1,
+        )
+        .map_err(|error| SceneError {
+            reason: format!(
+                "{}: the controller's fast integral gain {} /s needs ki T <= 1",
+                error.reason, CONTROL_RATE_RANGE_HZ.0
+            ),
+            ..error
+        })?;
     let duration_s = errors.positive("duration_s", raw.duration_s, 60.0)?;
     let plant_substeps = match raw.plant_substeps {
         None => DEFAULT_PLANT_SUBSTEPS,

@@ -24,6 +24,14 @@ pub use spec::{Mismatch, ModelKind, ModelSpec, RoughSurface};
 pub use table::{Breakpoint, TargetPoint};
 pub use target::Target;
 
+/// The control rates a scene may ask for, Hz, inclusive: the one source of the scene schema's
+/// range (`scene-toml`) and of what the controller accepts (`sonolube::control`, whose tuning
+/// checks at compile time that its gains hold over it). The low end is the controller's fast
+/// integral gain, 6000 /s (`sonolube::control::FAST_GAINS`): a PI step needs `ki T <= 1`, or
+/// each step's integral correction overshoots and the loop oscillates. The high end keeps a
+/// 60 s run within 6e6 control steps.
+pub const CONTROL_RATE_RANGE_HZ: (f64, f64) = (6_000.0, 100_000.0);
+
 /// Which system of the source papers a scene belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

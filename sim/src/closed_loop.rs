@@ -241,6 +241,9 @@ impl<'a> ClosedLoop<'a> {
         if scene.transducer.shift.bvd_envelope {
             // This plant samples its drive current every PWM period (`plant::transducer`).
             station.enable_current_sense();
+        } else {
+            // The simulated board would sample it: the scene's plant has none.
+            station.no_current_sense_in_scene();
         }
         let seed = scene.noise_seed;
         let (normal, tangential) = station.channels_mut();

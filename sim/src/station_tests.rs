@@ -161,7 +161,9 @@ fn a_drive_frequency_outside_the_range_is_refused_and_kept() {
 }
 
 /// `freq auto` on a plant without a sampled current is refused as `unavailable` with the
-/// reason, in every state (no longer the misleading `wrong-state ... in state idle`).
+/// reason, in every state (no longer the misleading `wrong-state ... in state idle`); the
+/// reason names the scene, the cause, not the board (issue 26: the same board accepts it in
+/// `resonance-drift`).
 #[test]
 fn freq_auto_without_current_samples_is_unavailable_and_says_why() {
     let mut run = operated();
@@ -170,7 +172,7 @@ fn freq_auto_without_current_samples_is_unavailable_and_says_why() {
     let mut text: heapless::String<128> = heapless::String::new();
     sonolube::protocol::format_error(&error, &mut text).unwrap();
     assert!(
-        text.contains("freq is unavailable: this board does not sample the drive current"),
+        text.contains("freq is unavailable: the scene has no current sensing"),
         "{text}"
     );
 }

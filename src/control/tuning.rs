@@ -194,6 +194,10 @@ pub fn tuned(settings: &Settings) -> Result<Settings, ConfigError> {
     })
 }
 
+// The scene schema's control-rate range is `CONTROL_RATE_RANGE_HZ` (one source for the loader
+// and the controller). The fast gain needs no floor on the rate: [`sampled_ki_cap_per_s`] keeps
+// `ki T <= 1 - m - kp` at any control period.
+
 /// The controller's settings for `scene`: [`Settings::REFERENCE`] with the tuning's
 /// departures ([`FORCE_FILTER_HZ`] for both force filters, [`VELOCITY_FILTER_HZ`],
 /// [`NATURAL_PRIOR_WEIGHT`], [`SLIDING_DEBOUNCE_S`], [`NATURAL_LEARN_S`], [`STEADY_GAINS`],
@@ -410,6 +414,24 @@ mod tests {
         assert!((s.tangential_force_range_n - 2.2).abs() < 1e-12);
         assert_eq!(s.velocity_range_m_s, 5.0);
         assert!(crate::control::Config::new(&s).is_ok());
+    }
+
+    #[test]
+    fn the_controller_accepts_exactly_the_schemas_control_rates() {
+        // Issue 26: the schema allowed 1e3 Hz while the controller refused below 6e3 Hz. Both
+        // ends of the one range build; just below its low end the fast PI step is refused.
+        let scene = find("reference").expect("built in");
+        let at = |rate_hz: f64| {
+            let scene = crate::scene::Scene {
+                control_rate_hz: rate_hz,
+                ..*scene
+            };
+            crate::control::Config::new(&controller_settings(&scene))
+        };
+        let (low, high) = crate::scene::CONTROL_RATE_RANGE_HZ;
+        assert!(at(low).is_ok());
+        assert!(at(high).is_ok());
+        assert!(at(low * (1.0 - 1e-9)).is_err());
     }
 
     #[test]

@@ -36,14 +36,14 @@
 //!
 //! | command | argument range and resolution | effect | `ok` reply (example) |
 //! |---|---|---|---|
-//! | `version` | | firmware and protocol version | `ok firmware=0.1.0 board=qemu protocol=1` |
-//! | `status` | | state, target and measurements | `ok state=running scene=demo target=force:12.500 mu=0.312000 normal_n=40.000 tangential_n=12.480 amp=0.523000 freq_hz=40000.00 overruns=0 lost=0 fault=none` |
+//! | `version` | | firmware and protocol version | `ok firmware=0.1.0 board=qemu protocol=2` |
+//! | `status` | | state, target and measurements | `ok state=running scene=demo target=force:12.500 mu=0.312000 normal_n=40.000 tangential_n=12.480 amp=0.523000 freq_hz=40000.00 overruns=0 lost=0 fault=none lock=none phase_deg=undefined reach=ok reachable=none resonance=near` |
 //! | `faults` | | latched and active faults | `ok latched=overcurrent active=none` |
 //! | `target force <N>` | `0 < N <= 50000` newtons, 0.001 N | hold this friction force | `ok target=force:12.500` |
 //! | `target coef <mu>` | `0 < mu <= 2`, 0.000001 | hold this friction coefficient | `ok target=coef:0.350000` |
-//! | `target reduction <r>` | `0 <= r < 100` percent, 0.001 % | hold this reduction of the natural friction | `ok target=reduction:40.000` |
-//! | `scene list` | | names of the scenes | `ok count=2 scenes=demo,ramp` |
-//! | `scene <name>` | `[a-z0-9_-]`, 1 to 24 bytes, not `list` or `none` | select a scene | `ok scene=demo` |
+//! | `target reduction <r>` | `0 <= r < 100` percent, 0.001 % | hold this reduction of the natural friction | `ok target=reduction:40.000`; beyond what the model reaches now at full drive: `ok target=reduction:99.999 warning=beyond-reach reachable=reduction:79.400` |
+//! | `scene list` | | names of every compiled scene (the reply is sized for them all) | `ok count=2 scenes=demo,ramp` |
+//! | `scene <name>` | `[a-z0-9_-]`, 1 to 24 bytes, not `list` or `none` | select a scene; one that cannot work (a target beyond the drive's reach, no sliding, cell noise above the band: [`crate::scene::feasibility`]) is refused as `unavailable` | `ok scene=demo` |
 //! | `start` | | drive on, close the friction loop | `ok` |
 //! | `stop` | | open the loop, drive off | `ok` |
 //! | `freq <Hz>` | `20000 <= f <= 60000` hertz, 0.01 Hz | fixed drive frequency; the actuator ceiling is recomputed for it (current rating) | `ok freq_hz=40000.00` |
@@ -77,7 +77,13 @@
 //! Status fields: `state` (see [`SupervisorState`]), `scene`, `target`, `mu` (friction
 //! coefficient estimate), `normal_n` and `tangential_n` (forces, N, 3 decimals), `amp` (drive
 //! amplitude as a fraction of full scale, 6 decimals), `freq_hz` (2 decimals), `overruns`,
-//! `lost` (telemetry records lost) and `fault` (latched fault or `none`).
+//! `lost` (telemetry records lost), `fault` (latched fault or `none`), `lock` and `phase_deg`
+//! (as in telemetry), and the reach fields of telemetry: `reach`, `reachable`, `resonance`.
+//!
+//! A `target` whose value is beyond what the controller's model reaches at the drive's ceiling
+//! at the present load and speed is still accepted (the load or speed may change), with
+//! `warning=beyond-reach reachable=<kind:value>` after the target: the nearest value the full
+//! drive gives now, in the target's kind.
 //!
 //! An error is `err <code> <name> <message>`: a stable number, its kebab-case name, and a
 //! message for a person that quotes the offending word and states the rule, for example
@@ -105,7 +111,7 @@
 //! | 24 | `cal-failed` | the calibration could not be completed |
 //! | 25 | `storage-failed` | the settings flash could not be read or written (`save`, `load`) |
 //! | 26 | `settings-invalid` | `load`: nothing stored, or the stored settings fail a check (the reason word says which) |
-//! | 27 | `unavailable` | the command exists but this loop cannot do it (`freq auto` on a board that does not sample the drive current); the message says why |
+//! | 27 | `unavailable` | the command exists but this loop cannot do it (`freq auto` on a board, or a simulated scene, that does not sample the drive current); the message says why |
 //!
 //! In the `save`, `load` and `defaults` replies a field at `none` is the scene's own (its
 //! datasheet calibration, its drive frequency, no target); offsets and spans are the exact
@@ -122,7 +128,7 @@
 //! One line per record, fields always present and always in this order:
 //!
 //! ```text
-//! tel t_us=1250000 seq=12500 state=running target=force:12.500 mu=0.312000 normal_n=40.000 tangential_n=12.480 amp=0.523000 freq_hz=40000.00 overruns=0 lost=0 lock=locked phase_deg=-0.250
+//! tel t_us=1250000 seq=12500 state=running target=force:12.500 mu=0.312000 normal_n=40.000 tangential_n=12.480 amp=0.523000 freq_hz=40000.00 overruns=0 lost=0 lock=locked phase_deg=-0.250 reach=ok reachable=none resonance=near
 //! ```
 //!
 //! | key | field | unit and format | range on the wire |
@@ -141,7 +147,12 @@
 //! | `lock` | the resonance loop's state ([`Lock`]) | `pinned`, `searching`, `tracking`, `locked`, `lost`, or `none` (no loop) | |
 //! | `phase_deg` | the motional current's phase to the drive voltage (the tracker's error; 0 on resonance) | degrees, 3 decimals (mdeg), signed, or `undefined` (nothing measured) | `-2147483.648..=2147483.647` |
 //!
-//! The longest record is 265 bytes with its newline ([`TELEMETRY_CAPACITY`] is 288). A gap in
+//! | `reach` | whether the target is held ([`ReachState`]) | `ok`, or `target-unreachable`: the drive at its limit for as long as it takes to act (3 x the envelope, cell and force-filter time constants) with the error not falling | |
+//! | `reachable` | with `target-unreachable`, the nearest value the model gives at the drive's limit now | a target as `target`, or `none` | |
+//! | `resonance` | the drive frequency against the resonance ([`ResonanceDistance`]) | `near` (motional conductance at least half the resonance's, `|2Q (f - f0) / f0| <= 1`), `far`, or `unknown` | |
+//!
+//! The longest record is 337 bytes with its newline ([`TELEMETRY_CAPACITY`] is 352).
+//! Protocol 2 added `reach`, `reachable` and `resonance` (issue 26). A gap in
 //! `seq` with a matching increase of `lost` means records were dropped, not corrupted.
 
 mod code;
@@ -155,6 +166,7 @@ mod name;
 mod number;
 mod parse;
 mod quantity;
+mod reach;
 mod reading;
 mod reply;
 mod report;
@@ -185,6 +197,7 @@ pub use quantity::{
     ALL_QUANTITIES, CAL_LOAD, DRIVE_FREQ, Quantity, TARGET_COEF, TARGET_FORCE, TARGET_REDUCTION,
     TELEMETRY_RATE,
 };
+pub use reach::{BEYOND_REACH, ReachState, ResonanceDistance, RunReach, format_target_ack};
 pub use reading::LoopReading;
 pub use reply::{NONE, OkReply, REPLY_CAPACITY, format_ack, format_error};
 pub use report::{
@@ -202,4 +215,4 @@ pub use text::{FormatError, MAX_DECIMALS, MAX_WORD_LEN, is_word};
 /// Version of this protocol, reported by `version`. Bumped when a line that one side sends
 /// could be read differently by the other (a new field, state or keyword); new error codes and
 /// commands that old hosts never send do not bump it.
-pub const PROTOCOL_VERSION: u16 = 1;
+pub const PROTOCOL_VERSION: u16 = 2;

@@ -14,10 +14,30 @@ use super::quantity::{CAL_LOAD, DRIVE_FREQ};
 use super::target::{Target, write_target};
 use super::text::{FormatError, put, put_fixed, put_uint, put_word, write_line};
 
-/// Buffer size (bytes) that holds every reply except a scene list of more than 12 full-length
-/// (24-byte) names. The longest other reply, a status with every field at its extreme and
-/// 32-byte scene and fault names, is 263 bytes.
-pub const REPLY_CAPACITY: usize = 320;
+/// Buffer size (bytes) that holds every reply: the longest of 384 bytes and the `scene list`
+/// reply of every compiled scene ([`crate::scene::SCENE_NAMES`]: the list is never cut, and
+/// its `count` is the number of names it gives). The longest other reply, a status with every
+/// field at its extreme and 32-byte scene and fault names and the reach fields, is 373 bytes.
+pub const REPLY_CAPACITY: usize = {
+    let list = scene_list_len(&crate::scene::SCENE_NAMES);
+    if list > 384 { list } else { 384 }
+};
+
+/// Bytes of the `scene list` reply for `names`: `ok count=N scenes=a,b,c\n` (`none` for no
+/// name).
+pub const fn scene_list_len(names: &[&str]) -> usize {
+    // "ok count=" + at most 10 digits + " scenes=" + "\n".
+    let mut len = 9 + 10 + 8 + 1;
+    if names.is_empty() {
+        return len + NONE.len();
+    }
+    let mut index = 0;
+    while index < names.len() {
+        len += names[index].len() + 1;
+        index += 1;
+    }
+    len
+}
 
 /// The list text of an empty list, and of an absent name or fault.
 pub const NONE: &str = "none";

@@ -31,6 +31,8 @@ pub struct StatusReport {
     /// The motional current's phase to the voltage (the tracker's phase error), millidegrees;
     /// `None` (`undefined`) before a window with current was measured.
     pub phase_mdeg: Option<i32>,
+    /// Whether the target is within reach, and the drive near the resonance.
+    pub reach: super::RunReach,
 }
 
 /// The data of a `faults` reply: names (words other than `none`) of faults.
@@ -80,7 +82,17 @@ pub fn format_status(report: &StatusReport, out: &mut StringView) -> Result<(), 
         Some(mdeg) => reply.fixed("phase_deg", i64::from(mdeg), 3),
         None => reply.word("phase_deg", "undefined"),
     };
-    reply.finish()
+    reply
+        .word("reach", report.reach.state.name())
+        .target("reachable", report.reach.reachable.as_ref())
+        .word(
+            "resonance",
+            report
+                .reach
+                .resonance
+                .map_or(super::reach::UNKNOWN_WORD, super::ResonanceDistance::name),
+        )
+        .finish()
 }
 
 /// Writes the `faults` reply: `ok latched=a,b active=c` (`none` for an empty list).
@@ -126,6 +138,28 @@ mod tests {
 
     type Line = String<REPLY_CAPACITY>;
 
+    /// Issue 26: `scene list` showed 16 of 22 compiled scenes with `count=16` (a board kept
+    /// 16 names, and the reply held 12 full-length ones). Every compiled scene fits the reply,
+    /// with the right count, whatever the names.
+    #[test]
+    fn the_scene_list_of_every_compiled_scene_fits_with_its_count() {
+        let mut out = Line::new();
+        format_scene_list(&crate::scene::SCENE_NAMES, &mut out).unwrap();
+        let expected = std::format!(
+            "ok count={} scenes={}\n",
+            crate::scene::SCENES.len(),
+            crate::scene::SCENE_NAMES.join(",")
+        );
+        assert_eq!(out.as_str(), expected);
+        // The capacity follows the names: 22 full-length names fit a buffer sized for them.
+        let name = "n".repeat(24);
+        let names: Vec<&str> = (0..22).map(|_| name.as_str()).collect();
+        let needed = crate::protocol::reply::scene_list_len(&names);
+        let mut big: String<{ 22 * 25 + 28 }> = String::new();
+        format_scene_list(&names, &mut big).unwrap();
+        assert!(big.len() <= needed, "{} > {needed}", big.len());
+    }
+
     fn status_example() -> StatusReport {
         StatusReport {
             reading: LoopReading {
@@ -143,6 +177,7 @@ mod tests {
             latched_fault: None,
             lock: Some("locked"),
             phase_mdeg: Some(-1_234),
+            reach: crate::protocol::RunReach::UNKNOWN,
         }
     }
 
@@ -154,18 +189,18 @@ mod tests {
             out,
             "ok state=running scene=demo target=force:12.500 mu=0.312000 normal_n=40.000 \
              tangential_n=12.480 amp=0.523000 freq_hz=40000.00 overruns=0 lost=0 fault=none \
-             lock=locked phase_deg=-1.234\n"
+             lock=locked phase_deg=-1.234 reach=ok reachable=none resonance=unknown\n"
         );
         let Ok(Reply::Ok(payload)) = parse_reply(&out) else {
             panic!("{out}")
         };
         assert_eq!(payload.get("tangential_n"), Some("12.480"));
-        assert_eq!(payload.pairs().count(), 13);
+        assert_eq!(payload.pairs().count(), 16);
         let mut undefined = status_example();
         undefined.phase_mdeg = None;
         undefined.lock = None;
         format_status(&undefined, &mut out).unwrap();
-        assert!(out.ends_with("lock=none phase_deg=undefined\n"), "{out}");
+        assert!(out.contains(" lock=none phase_deg=undefined "), "{out}");
     }
 
     #[test]
@@ -191,10 +226,17 @@ mod tests {
             // The longest lock word.
             lock: Some("searching"),
             phase_mdeg: Some(i32::MIN),
+            reach: crate::protocol::RunReach {
+                state: crate::protocol::ReachState::TargetUnreachable,
+                reachable: Some(Target::Reduction {
+                    reduction_mpct: u32::MAX,
+                }),
+                resonance: Some(crate::protocol::ResonanceDistance::Near),
+            },
         };
         let mut out = Line::new();
         format_status(&report, &mut out).unwrap();
-        assert_eq!(out.len(), 301, "{out}");
+        assert_eq!(out.len(), 373, "{out}");
     }
 
     #[test]
@@ -225,15 +267,17 @@ mod tests {
             protocol: crate::protocol::PROTOCOL_VERSION,
         };
         format_version(&version, &mut out).unwrap();
-        assert_eq!(out, "ok firmware=0.1.0 board=qemu protocol=1\n");
+        assert_eq!(out, "ok firmware=0.1.0 board=qemu protocol=2\n");
 
         format_scene_list(&["demo", "ramp"], &mut out).unwrap();
         assert_eq!(out, "ok count=2 scenes=demo,ramp\n");
         format_scene_list(&[], &mut out).unwrap();
         assert_eq!(out, "ok count=0 scenes=none\n");
+        // A list that does not fit is refused whole, never cut.
         let name = "n".repeat(24);
-        let names: Vec<&str> = (0..13).map(|_| name.as_str()).collect();
-        format_scene_list(&names[..12], &mut out).unwrap();
+        let fits = (REPLY_CAPACITY - 28) / 25;
+        let names: Vec<&str> = (0..=fits).map(|_| name.as_str()).collect();
+        format_scene_list(&names[..fits], &mut out).unwrap();
         assert_eq!(
             format_scene_list(&names, &mut out),
             Err(FormatError::Overflow)

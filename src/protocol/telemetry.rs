@@ -9,6 +9,7 @@ use heapless::string::StringView;
 use super::decode::{DecodeError, check_pairs, strip_terminator, words};
 use super::lock::Lock;
 use super::number::{NumberError, decode_i32, decode_u32, decode_u64};
+use super::reach::{ReachState, ResonanceDistance, RunReach, UNKNOWN_WORD};
 use super::reading::LoopReading;
 use super::state::SupervisorState;
 use super::target::{decode_target, write_target};
@@ -17,8 +18,9 @@ use super::text::{FormatError, put, put_fixed, put_uint, write_line};
 /// First word of every telemetry line; replies start with `ok` or `err`.
 pub const TELEMETRY_TAG: &str = "tel";
 
-/// Buffer size (bytes) that holds every telemetry line; the longest possible line is 265 bytes.
-pub const TELEMETRY_CAPACITY: usize = 288;
+/// Buffer size (bytes) that holds every telemetry line; the longest possible line is 337 bytes
+/// (265 before the reach fields of protocol 2).
+pub const TELEMETRY_CAPACITY: usize = 352;
 
 /// One telemetry sample. All fields take their full integer range on the wire.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -39,6 +41,8 @@ pub struct TelemetryRecord {
     /// The motional current's phase to the drive voltage, mdeg; `None` (`undefined`) before
     /// anything was measured.
     pub phase_mdeg: Option<i32>,
+    /// Whether the target is within reach, and the drive near the resonance.
+    pub reach: RunReach,
 }
 
 // Keys in line order; the decoder names them in its errors.
@@ -55,6 +59,9 @@ const KEY_OVERRUNS: &str = "overruns";
 const KEY_LOST: &str = "lost";
 const KEY_LOCK: &str = "lock";
 const KEY_PHASE: &str = "phase_deg";
+const KEY_REACH: &str = "reach";
+const KEY_REACHABLE: &str = "reachable";
+const KEY_RESONANCE: &str = "resonance";
 /// The word of an undefined phase.
 const UNDEFINED: &str = "undefined";
 
@@ -109,6 +116,18 @@ pub fn format_telemetry(record: &TelemetryRecord, out: &mut StringView) -> Resul
             Some(mdeg) => put_fixed(out, i64::from(mdeg), MN_DECIMALS)?,
             None => put(out, UNDEFINED)?,
         }
+        key(out, KEY_REACH)?;
+        put(out, record.reach.state.name())?;
+        key(out, KEY_REACHABLE)?;
+        write_target(out, record.reach.reachable.as_ref())?;
+        key(out, KEY_RESONANCE)?;
+        put(
+            out,
+            record
+                .reach
+                .resonance
+                .map_or(UNKNOWN_WORD, ResonanceDistance::name),
+        )?;
         put(out, "\n")
     })
 }
@@ -165,37 +184,47 @@ pub fn parse_telemetry(line: &str) -> Result<TelemetryRecord, DecodeError> {
         .unwrap_or("");
     check_pairs(body)?;
     let mut fields = Fields { words: all };
-    let record =
-        TelemetryRecord {
-            time_us: fields.number(KEY_TIME, 0, decode_u64)?,
-            seq: fields.number(KEY_SEQ, 0, decode_u32)?,
-            reading: LoopReading {
-                state: SupervisorState::from_name(fields.next(KEY_STATE)?)
-                    .ok_or(DecodeError::BadState)?,
-                target: decode_target(fields.next(KEY_TARGET)?).map_err(DecodeError::BadTarget)?,
-                friction_coef_ppm: fields.number(KEY_MU, PPM_DECIMALS, decode_u32)?,
-                normal_force_mn: fields.number(KEY_NORMAL, MN_DECIMALS, decode_i32)?,
-                tangential_force_mn: fields.number(KEY_TANGENTIAL, MN_DECIMALS, decode_i32)?,
-                drive_amplitude_ppm: fields.number(KEY_AMP, PPM_DECIMALS, decode_u32)?,
-                drive_freq_chz: fields.number(KEY_FREQ, CHZ_DECIMALS, decode_u32)?,
-            },
-            overruns: fields.number(KEY_OVERRUNS, 0, decode_u32)?,
-            lost_records: fields.number(KEY_LOST, 0, decode_u32)?,
-            lock: match fields.next(KEY_LOCK)? {
-                word if word == super::NONE => None,
-                // An unknown lock word is a bad state word, like `state=`'s.
-                word => Some(Lock::from_name(word).ok_or(DecodeError::BadState)?),
-            },
-            phase_mdeg: match fields.next(KEY_PHASE)? {
-                UNDEFINED => None,
-                value => Some(decode_i32(value, MN_DECIMALS).map_err(|error| {
-                    DecodeError::BadNumber {
+    let record = TelemetryRecord {
+        time_us: fields.number(KEY_TIME, 0, decode_u64)?,
+        seq: fields.number(KEY_SEQ, 0, decode_u32)?,
+        reading: LoopReading {
+            state: SupervisorState::from_name(fields.next(KEY_STATE)?)
+                .ok_or(DecodeError::BadState)?,
+            target: decode_target(fields.next(KEY_TARGET)?).map_err(DecodeError::BadTarget)?,
+            friction_coef_ppm: fields.number(KEY_MU, PPM_DECIMALS, decode_u32)?,
+            normal_force_mn: fields.number(KEY_NORMAL, MN_DECIMALS, decode_i32)?,
+            tangential_force_mn: fields.number(KEY_TANGENTIAL, MN_DECIMALS, decode_i32)?,
+            drive_amplitude_ppm: fields.number(KEY_AMP, PPM_DECIMALS, decode_u32)?,
+            drive_freq_chz: fields.number(KEY_FREQ, CHZ_DECIMALS, decode_u32)?,
+        },
+        overruns: fields.number(KEY_OVERRUNS, 0, decode_u32)?,
+        lost_records: fields.number(KEY_LOST, 0, decode_u32)?,
+        lock: match fields.next(KEY_LOCK)? {
+            word if word == super::NONE => None,
+            // An unknown lock word is a bad state word, like `state=`'s.
+            word => Some(Lock::from_name(word).ok_or(DecodeError::BadState)?),
+        },
+        phase_mdeg: match fields.next(KEY_PHASE)? {
+            UNDEFINED => None,
+            value => {
+                Some(
+                    decode_i32(value, MN_DECIMALS).map_err(|error| DecodeError::BadNumber {
                         key: KEY_PHASE,
                         error,
-                    }
-                })?),
+                    })?,
+                )
+            }
+        },
+        reach: RunReach {
+            state: ReachState::from_name(fields.next(KEY_REACH)?).ok_or(DecodeError::BadState)?,
+            reachable: decode_target(fields.next(KEY_REACHABLE)?)
+                .map_err(DecodeError::BadTarget)?,
+            resonance: match fields.next(KEY_RESONANCE)? {
+                UNKNOWN_WORD => None,
+                word => Some(ResonanceDistance::from_name(word).ok_or(DecodeError::BadState)?),
             },
-        };
+        },
+    };
     match fields.words.next() {
         Some(_) => Err(DecodeError::ExtraField),
         None => Ok(record),
@@ -214,7 +243,8 @@ mod tests {
 
     const EXAMPLE: &str = "tel t_us=1250000 seq=12500 state=running target=force:12.500 \
         mu=0.312000 normal_n=40.000 tangential_n=-12.480 amp=0.523000 freq_hz=40000.00 \
-        overruns=0 lost=3 lock=locked phase_deg=-0.250\n";
+        overruns=0 lost=3 lock=locked phase_deg=-0.250 reach=target-unreachable \
+        reachable=force:14.000 resonance=near\n";
 
     fn example() -> TelemetryRecord {
         TelemetryRecord {
@@ -233,6 +263,11 @@ mod tests {
             lost_records: 3,
             lock: Some(Lock::Locked),
             phase_mdeg: Some(-250),
+            reach: RunReach {
+                state: ReachState::TargetUnreachable,
+                reachable: Some(Target::Force { force_mn: 14_000 }),
+                resonance: Some(ResonanceDistance::Near),
+            },
         }
     }
 
@@ -269,9 +304,16 @@ mod tests {
             lost_records: u32::MAX,
             lock: Some(Lock::Searching),
             phase_mdeg: Some(i32::MIN),
+            reach: RunReach {
+                state: ReachState::TargetUnreachable,
+                reachable: Some(Target::Reduction {
+                    reduction_mpct: u32::MAX,
+                }),
+                resonance: Some(ResonanceDistance::Near),
+            },
         };
         let text = line(&record);
-        assert_eq!(text.len(), 265, "{text}");
+        assert_eq!(text.len(), 337, "{text}");
         assert_eq!(parse_telemetry(&text), Ok(record));
     }
 
@@ -285,20 +327,34 @@ mod tests {
             Err(DecodeError::UnexpectedField { key: "seq" })
         );
         assert_eq!(
-            parse_telemetry(&replace(" phase_deg=-0.250", "")),
-            Err(DecodeError::MissingField { key: "phase_deg" })
+            parse_telemetry(&replace(" resonance=near", "")),
+            Err(DecodeError::MissingField { key: "resonance" })
         );
         assert_eq!(
-            parse_telemetry(&replace("phase_deg=-0.250", "phase_deg=-0.250 extra=1")),
+            parse_telemetry(&replace("resonance=near", "resonance=near extra=1")),
             Err(DecodeError::ExtraField)
         );
         assert_eq!(
-            parse_telemetry(&replace("phase_deg=-0.250", "phase_deg=-0.250 extra")),
-            Err(DecodeError::BadPair { index: 13 })
+            parse_telemetry(&replace("resonance=near", "resonance=near extra")),
+            Err(DecodeError::BadPair { index: 16 })
         );
         assert_eq!(
             parse_telemetry(&replace("lock=locked", "lock=wobbly")),
             Err(DecodeError::BadState)
+        );
+        assert_eq!(
+            parse_telemetry(&replace("reach=target-unreachable", "reach=maybe")),
+            Err(DecodeError::BadState)
+        );
+        assert_eq!(
+            parse_telemetry(&replace("resonance=near", "resonance=unknown")),
+            Ok(TelemetryRecord {
+                reach: RunReach {
+                    resonance: None,
+                    ..example().reach
+                },
+                ..example()
+            })
         );
         assert_eq!(
             parse_telemetry(&replace("phase_deg=-0.250", "phase_deg=undefined")),
@@ -363,6 +419,9 @@ mod tests {
             (
                 proptest::option::of(proptest::sample::select(&Lock::ALL[..])),
                 proptest::option::of(any::<i32>()),
+                proptest::sample::select(&ReachState::ALL[..]),
+                any_target(),
+                proptest::option::of(proptest::sample::select(&ResonanceDistance::ALL[..])),
             ),
         )
             .prop_map(
@@ -371,7 +430,7 @@ mod tests {
                     target,
                     (mu, normal, tangential),
                     (amp, freq, overruns, lost),
-                    (lock, phase_mdeg),
+                    (lock, phase_mdeg, reach, reachable, resonance),
                 )| {
                     TelemetryRecord {
                         time_us,
@@ -389,6 +448,11 @@ mod tests {
                         lost_records: lost,
                         lock,
                         phase_mdeg,
+                        reach: RunReach {
+                            state: reach,
+                            reachable,
+                            resonance,
+                        },
                     }
                 },
             )

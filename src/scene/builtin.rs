@@ -27,6 +27,12 @@ mod tests {
     use crate::scene::in_build;
 
     #[test]
+    fn the_name_list_is_every_scene_in_order() {
+        let names: std::vec::Vec<&str> = SCENES.iter().map(|s| s.name).collect();
+        assert_eq!(names, SCENE_NAMES);
+    }
+
+    #[test]
     fn every_scene_is_found_by_its_valid_unique_name() {
         assert!(!SCENES.is_empty());
         for scene in SCENES {

@@ -20,11 +20,13 @@
 //! of the profiles ([`interpolate`], [`target_at`]) is in `f32`, the plant's format.
 
 pub mod builtin;
+pub mod feasibility;
 mod table;
 
-pub use builtin::{SCENES, find};
+pub use builtin::{SCENE_NAMES, SCENES, find};
 // The plain scene types, defined once in `sonolube-scene-types` and shared with the scene-file
 // loader (`scene-toml`), which reads them on the host and writes them for the build script.
+pub use sonolube_scene_types::CONTROL_RATE_RANGE_HZ;
 pub use sonolube_scene_types::{
     Accuracy, Actuator, ActuatorKind, Breakpoint, Channel, Contents, Criterion, FaultEvent,
     FaultKind, Horn, LoadCell, Mismatch, ModelKind, ModelSpec, Rail, ResonanceShift, RoughSurface,
@@ -56,7 +58,8 @@ pub struct Scene<'a> {
     pub system: System,
     /// The materials in contact, in words (`"Al horn / SS block"`), at most 60 bytes.
     pub materials: &'a str,
-    /// Control-loop rate, which is also the plant's step rate, Hz, 1e3 ..= 1e5 (default 1e4).
+    /// Control-loop rate, which is also the plant's step rate, Hz, within
+    /// [`CONTROL_RATE_RANGE_HZ`] (6e3 ..= 1e5; default 1e4).
     pub control_rate_hz: f64,
     /// Length of the run, s, (0, 60].
     pub duration_s: f64,

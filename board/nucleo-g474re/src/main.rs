@@ -106,9 +106,6 @@ const KEEPER_EVERY_MS: u64 = 5;
 /// if the loop has not stepped by then (a hung start-up then ends in a watchdog reset).
 const CONTROL_START_LIMIT: Duration = Duration::from_secs(1);
 
-/// Most scenes the console lists.
-const MAX_SCENES: usize = 16;
-
 /// The NUCLEO-G474RE board.
 struct NucleoG474re;
 
@@ -346,15 +343,8 @@ async fn main(spawner: Spawner) {
         store: settings_flash::open(p.FLASH),
     };
 
-    static SCENE_NAMES: StaticCell<[&'static str; MAX_SCENES]> = StaticCell::new();
-    let slots = SCENE_NAMES.init([""; MAX_SCENES]);
-    let mut count = 0;
-    for (slot, scene) in slots.iter_mut().zip(sonolube::scene::builtin::SCENES) {
-        *slot = scene.name;
-        count += 1;
-    }
-    let slots: &'static [&'static str] = slots;
-    let names = slots.get(..count).unwrap_or(&[]);
+    // Every compiled scene (issue 26: a list of 16 hid the rest).
+    let names: &'static [&'static str] = &sonolube::scene::SCENE_NAMES;
     static IDENTITY: StaticCell<Identity> = StaticCell::new();
     let identity = IDENTITY.init(Identity {
         firmware: env!("CARGO_PKG_VERSION"),

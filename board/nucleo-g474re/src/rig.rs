@@ -197,6 +197,17 @@ impl BoardRig {
         };
         match Setup::new(scene) {
             Ok(setup) => {
+                // What cannot work is refused before it runs (issue 26).
+                let feasibility = setup.station.feasibility(scene);
+                for finding in feasibility.findings() {
+                    defmt::warn!("scene {=str}: {}", scene.name, finding);
+                }
+                if let Some(refusal) = feasibility.refusal() {
+                    return Err(ProtocolError::Unavailable {
+                        command: command.keyword(),
+                        reason: refusal.summary(),
+                    });
+                }
                 self.setup.bridge.off();
                 self.setup = setup;
                 self.setup.bridge.install();
@@ -400,8 +411,13 @@ impl ControlLoop for BoardRig {
                     .map(|fault| Reason::SensorFault(fault).name()),
                 cycles,
             )
-            .with_resonance(setup.station.resonance()),
+            .with_resonance(setup.station.resonance())
+            .with_reach(setup.station.run_reach()),
         )
+    }
+
+    fn target_warning(&self) -> Option<sonolube::protocol::Target> {
+        self.setup.station.target_warning()
     }
 
     fn execute(&mut self, command: &Command) -> Result<(), ProtocolError> {

@@ -51,6 +51,10 @@ impl<R: ControlLoop> ControlLoop for Failing<'_, R> {
     fn trip_overrun(&mut self) {
         self.rig.trip_overrun()
     }
+
+    fn target_warning(&self) -> Option<sonolube::protocol::Target> {
+        self.rig.target_warning()
+    }
 }
 
 /// Runs the control loop on `rig` until the scene's `steps` are taken; a failure test build

@@ -93,9 +93,6 @@ impl Board for Qemu {
     }
 }
 
-/// Most scenes the console lists.
-const MAX_SCENES: usize = 16;
-
 /// In test builds, fails the boot self-check in the way the build's feature names.
 fn inject_boot_failure(wakeups: u32) {
     const AT: u32 = heartbeat::WAKEUPS_PER_REPORT * heartbeat::REPORTS / 2;
@@ -275,14 +272,8 @@ fn main() -> ! {
         Qemu::NAME,
         time_driver::CORE_CLOCK_HZ
     );
-    static SCENE_NAMES: StaticCell<heapless::Vec<&'static str, MAX_SCENES>> = StaticCell::new();
-    let names = SCENE_NAMES.init(
-        sonolube::scene::builtin::SCENES
-            .iter()
-            .map(|scene| scene.name)
-            .take(MAX_SCENES)
-            .collect(),
-    );
+    // Every compiled scene (issue 26: a list of 16 hid the rest).
+    let names: &'static [&'static str] = &sonolube::scene::SCENE_NAMES;
     static IDENTITY: StaticCell<Identity> = StaticCell::new();
     let identity = IDENTITY.init(Identity {
         firmware: env!("CARGO_PKG_VERSION"),

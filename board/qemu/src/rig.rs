@@ -188,6 +188,18 @@ impl SimulatedRig {
         let run = time_driver::exclude(|| ClosedLoop::operated(scene));
         match run {
             Ok(run) => {
+                // What cannot work is refused before it runs (issue 26); the built-in scenes
+                // all pass (`sonolube::scene::feasibility` tests).
+                let feasibility = run.station().feasibility(scene);
+                for finding in feasibility.findings() {
+                    defmt::warn!("scene {=str}: {}", name.as_str(), finding);
+                }
+                if let Some(refusal) = feasibility.refusal() {
+                    return Err(ProtocolError::Unavailable {
+                        command: command.keyword(),
+                        reason: refusal.summary(),
+                    });
+                }
                 self.scene = scene;
                 self.run = run;
                 self.pristine = true;
@@ -294,8 +306,13 @@ impl ControlLoop for SimulatedRig {
                     .map(|fault| sonolube::control::Reason::SensorFault(fault).name()),
                 u32::try_from(cycles).unwrap_or(u32::MAX),
             )
-            .with_resonance(self.run.station().resonance()),
+            .with_resonance(self.run.station().resonance())
+            .with_reach(self.run.station().run_reach()),
         )
+    }
+
+    fn target_warning(&self) -> Option<sonolube::protocol::Target> {
+        self.run.station().target_warning()
     }
 
     fn execute(&mut self, command: &Command) -> Result<(), ProtocolError> {

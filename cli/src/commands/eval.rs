@@ -21,7 +21,9 @@
 //! stand-in nor a limit value. `"flags": {key: reason}` names an input `f` outside the 20-60 kHz
 //! drive band and an output outside its physical range (for example a friction ratio below
 //! zero); the numbers are kept, the flag says why they are not physical. Both fields are
-//! present only when not empty.
+//! present only when not empty. Numbers in flags are short (`1e-300`, never 300 digits); a
+//! `reduction_pct` within the rounding of `100 (1 - ratio)` at ratio 1 ([`PERCENT_ROUNDING`])
+//! is written as 0 and flagged with the value it had.
 
 use std::collections::BTreeMap;
 use std::io::{BufRead, Write};
@@ -29,7 +31,7 @@ use std::process::ExitCode;
 
 use serde_json::{Map, Value, json};
 
-use sonolube_host::fixed_eval::extremes::{flags, undefined_keys, undefined_reason};
+use sonolube_host::fixed_eval::extremes::{flags, short_number, undefined_keys, undefined_reason};
 use sonolube_host::fixed_eval::{Outputs, eval_fixed_named, models};
 use sonolube_host::reference::eval_named;
 
@@ -185,7 +187,30 @@ pub fn evaluate(
         Err(e) => return error(e.to_string()),
     };
     match eval_fixed_named(model, inputs, variant) {
-        Ok(outputs) => answer(model, inputs, &outputs, &reference),
+        Ok(outputs) => {
+            let mut fixed = outputs;
+            let mut reference = reference;
+            let rounded = [
+                ("the fixed point", zero_within_rounding(&mut fixed)),
+                ("the reference", zero_within_rounding(&mut reference)),
+            ];
+            let mut answer = answer(model, inputs, &fixed, &reference);
+            for (side, value) in rounded {
+                if let Some(x) = value {
+                    add_flag(
+                        &mut answer,
+                        PERCENT_KEY,
+                        format!(
+                            "{side}: {} % is within the rounding of 100 (1 - F'/F) at F'/F = 1 \
+                             (8 ulps of 1, {} %): written as 0",
+                            short_number(x),
+                            short_number(PERCENT_ROUNDING)
+                        ),
+                    );
+                }
+            }
+            answer
+        }
         Err(e) => error(format!("fixed point: {e}")),
     }
 }
@@ -233,6 +258,41 @@ fn as_json(outputs: &Outputs, undefined: &Map<String, Value>) -> Value {
         map.entry(key.clone()).or_insert(Value::Null);
     }
     Value::Object(map)
+}
+
+/// The output that is a percentage of a ratio near 1: `100 (1 - ratio)`.
+const PERCENT_KEY: &str = "reduction_pct";
+
+/// How far from zero `100 (1 - ratio)` lands from rounding alone when the ratio is 1: 8 ulps
+/// of 1, in percent (1.8e-13 %). The cube model with A = B = 0 gave -2.2e-14 % (issue 26).
+pub const PERCENT_ROUNDING: f64 = 100.0 * 8.0 * f64::EPSILON;
+
+/// Sets a `reduction_pct` within [`PERCENT_ROUNDING`] of zero to zero; the value it had.
+fn zero_within_rounding(outputs: &mut sonolube_host::fixed_eval::Outputs) -> Option<f64> {
+    let value = outputs.get_mut(PERCENT_KEY)?;
+    if *value != 0.0 && value.abs() < PERCENT_ROUNDING {
+        let was = *value;
+        *value = 0.0;
+        return Some(was);
+    }
+    None
+}
+
+/// Adds (or extends) the flag of `key` in an answer.
+fn add_flag(answer: &mut Value, key: &str, why: String) {
+    let Some(object) = answer.as_object_mut() else {
+        return;
+    };
+    let flags = object
+        .entry("flags")
+        .or_insert_with(|| Value::Object(Map::new()));
+    if let Some(flags) = flags.as_object_mut() {
+        let text = match flags.get(key).and_then(Value::as_str) {
+            Some(before) => format!("{before}; {why}"),
+            None => why,
+        };
+        flags.insert(key.to_string(), json!(text));
+    }
 }
 
 fn error(message: String) -> Value {

@@ -5,7 +5,7 @@
 //! per scene: its verdicts, then the model it ran.
 //!
 //! ```text
-//! sonolube scene NAME [--out DIR] [--file PATH.toml] [--commission]
+//! sonolube scene NAME [--out DIR] [--file PATH.toml] [--commission] [--csv all|none|every N]
 //! sonolube scene --all [--out DIR]
 //! sonolube scene NAME|--all --seeds N|A-B [--plot PATH.svg]
 //! sonolube scene NAME --mismatch|--envelope|--noise|--resonators [--seeds N|A-B] [--out DIR]
@@ -34,6 +34,17 @@
 //! message names the scene values and why, see `why.rs`); 2 for a usage error (an unknown
 //! option or scene name, a missing value, `NAME` and `--file` naming different scenes). The
 //! output is deterministic.
+//!
+//! Before a run the scene is judged against what its physics and its controller allow
+//! ([`sonolube::scene::feasibility`]): a target beyond the drive's reach, a speed below the
+//! sliding threshold, cell noise larger than the band are refused with the key and the number
+//! that fails (exit 1); where the scene may hold with no margin, the report ends with a
+//! `warning:` line.
+//!
+//! A long run shows its progress on a terminal (on stderr; nothing when stderr is not a
+//! terminal). `--csv none` writes no CSV and `--csv every N` one row in N (rows where the
+//! supervisor changes state are always kept): a 60 s scene at 100 kHz is 6 million rows.
+//! The SVG is drawn from the rows kept (with `none`, about 20,000 of them).
 //!
 //! # CSV columns
 //!
@@ -80,7 +91,8 @@ use sonolube_sim::{ClosedLoop, RunSummary};
 pub use csv::csv;
 pub use report::{model_line, model_name, short};
 
-const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml] [--model VARIANT] [--commission]\n       \
+const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml] [--model VARIANT] [--commission] \
+                     [--csv all|none|every N]\n       \
                      sonolube scene --all [--out DIR]\n       \
                      sonolube scene NAME|--all --seeds N|A-B [--plot PATH.svg]\n       \
                      sonolube scene NAME --mismatch|--envelope|--noise|--resonators [--seeds N|A-B] [--out DIR]\n       \
@@ -101,6 +113,7 @@ pub fn run(args: &[String]) -> ExitCode {
     let mut sweep = None;
     let mut pinned = false;
     let mut commission = false;
+    let mut rows = Rows::All;
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
         match arg.as_str() {
@@ -136,6 +149,17 @@ pub fn run(args: &[String]) -> ExitCode {
             }
             "--pinned" => pinned = true,
             "--commission" => commission = true,
+            "--csv" => {
+                rows = match rest.next().map(String::as_str) {
+                    Some("all") => Rows::All,
+                    Some("none") => Rows::None,
+                    Some("every") => match rest.next().map(|n| n.parse::<u32>()) {
+                        Some(Ok(n)) if n >= 1 => Rows::Every(n),
+                        _ => return usage("--csv every needs a whole number N >= 1"),
+                    },
+                    _ => return usage("--csv takes all, none or every N"),
+                }
+            }
             "-h" | "--help" => {
                 print!("{USAGE}");
                 return ExitCode::SUCCESS;
@@ -154,6 +178,9 @@ pub fn run(args: &[String]) -> ExitCode {
         }
     }
     let robust = seeds.is_some() || sweep.is_some();
+    if rows != Rows::All && (all || robust) {
+        return usage("--csv goes with a single run of one scene");
+    }
     if plot.is_some() && !robust {
         return usage("--plot goes with --seeds, --mismatch, --envelope, --noise or --resonators");
     }
@@ -217,7 +244,7 @@ pub fn run(args: &[String]) -> ExitCode {
             &out,
         );
     }
-    match run_forced(&scene, &out, forced) {
+    match run_with(&scene, &out, forced, rows) {
         Ok(run) => {
             print!("{}", run.report);
             exit(run.summary.passed())
@@ -351,25 +378,84 @@ pub fn run_forced(
     out: &Path,
     forced: Option<&sonolube::variant::Variant>,
 ) -> Result<SceneRun, String> {
+    run_with(scene, out, forced, Rows::All)
+}
+
+/// Which rows of a run the CSV gets (`--csv`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Rows {
+    /// Every control step (the default).
+    All,
+    /// No CSV file.
+    None,
+    /// One step in N, and every step where the supervisor changes state.
+    Every(u32),
+}
+
+/// Rows an SVG needs at most: with `--csv none` the run keeps one step in
+/// `step_count / SVG_ROWS`.
+const SVG_ROWS: u32 = 20_000;
+
+/// [`run_forced`] writing the CSV rows `rows` asks for, with a progress bar on a terminal.
+pub fn run_with(
+    scene: &Scene<'_>,
+    out: &Path,
+    forced: Option<&sonolube::variant::Variant>,
+    rows: Rows,
+) -> Result<SceneRun, String> {
     let built = match forced {
         Some(variant) => {
             let model = sonolube::variant::fixed::fixed_model(scene, variant)
                 .map_err(|e| format!("{}: {e}", variant.name))?;
             ClosedLoop::with_model(scene, model)
         }
-        None => ClosedLoop::with_selection(scene, crate::speed::table_rs::select_on_host(scene)?),
+        None => ClosedLoop::with_selection(
+            scene,
+            crate::speed::table_rs::select_on_host(scene)
+                .map_err(|error| why::cannot_select(scene, &error))?,
+        ),
     };
     let mut sim = built.map_err(|e| why::cannot_run(scene, &e))?;
-    let mut records = Vec::with_capacity(scene.step_count() as usize);
-    while let Some(record) = sim.step() {
-        records.push(record);
+    // What cannot work is refused before the run, with the number that fails (issue 26).
+    let feasibility = sonolube::scene::feasibility::check(scene, sim.station().model());
+    if let Some(refusal) = feasibility.refusal() {
+        return Err(refusal.to_string());
     }
+    let steps = scene.step_count();
+    let every = match rows {
+        Rows::All => 1,
+        Rows::Every(n) => n,
+        Rows::None => steps.div_ceil(SVG_ROWS).max(1),
+    };
+    let mut records = Vec::with_capacity((steps / every) as usize + 1);
+    // Hidden when stderr is not a terminal (indicatif's default draw target).
+    let progress = indicatif::ProgressBar::new(u64::from(steps));
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{prefix} [{bar:30}] {percent:>3} % of {len} steps, {eta} left",
+    ) {
+        progress.set_style(style.progress_chars("=> "));
+    }
+    progress.set_prefix(scene.name.to_string());
+    let mut last_state = None;
+    while let Some(record) = sim.step() {
+        if record.step % 4096 == 0 {
+            progress.set_position(u64::from(record.step));
+        }
+        if record.step % every == 0 || last_state != Some(record.state) || record.step == 1 {
+            last_state = Some(record.state);
+            records.push(record);
+        }
+    }
+    progress.finish_and_clear();
     let summary = sim.summary();
     let station = sim.station();
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let csv_path = out.join(format!("{}.csv", scene.name));
     let svg_path = out.join(format!("{}.svg", scene.name));
-    std::fs::write(&csv_path, csv(&records)).map_err(|e| format!("{}: {e}", csv_path.display()))?;
+    if rows != Rows::None {
+        std::fs::write(&csv_path, csv(&records))
+            .map_err(|e| format!("{}: {e}", csv_path.display()))?;
+    }
     std::fs::write(&svg_path, svg(scene, &summary, &records))
         .map_err(|e| format!("{}: {e}", svg_path.display()))?;
     let mut text = String::new();
@@ -377,12 +463,24 @@ pub fn run_forced(
         text.push_str(&commissioned_lines(scene, result));
     }
     text.push_str(&report(scene, station, &summary, &records));
-    let _ = writeln!(
-        text,
-        "  wrote {} and {}",
-        csv_path.display(),
-        svg_path.display()
-    );
+    for warning in feasibility.warnings() {
+        let _ = writeln!(text, "  {warning}");
+    }
+    let _ = match rows {
+        Rows::None => writeln!(text, "  wrote {} (no CSV)", svg_path.display()),
+        Rows::All => writeln!(
+            text,
+            "  wrote {} and {}",
+            csv_path.display(),
+            svg_path.display()
+        ),
+        Rows::Every(n) => writeln!(
+            text,
+            "  wrote {} (one step in {n}) and {}",
+            csv_path.display(),
+            svg_path.display()
+        ),
+    };
     Ok(SceneRun {
         summary,
         report: text,

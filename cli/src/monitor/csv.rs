@@ -13,6 +13,8 @@
 //! | `freq_hz` | Hz, 2 decimals |
 //! | `overruns` | control-loop overruns since boot |
 //! | `lost` | telemetry records lost since boot |
+//! | `lock`, `phase_deg` | resonance loop state, motional phase (degrees) |
+//! | `reach`, `reachable`, `resonance` | `ok` or `target-unreachable`, the value the full drive reaches (or `none`), `near`/`far`/`unknown` |
 
 use std::fmt::Write as _;
 
@@ -21,8 +23,8 @@ use sonolube::protocol::TelemetryRecord;
 use super::reports::{fixed, target_text};
 
 /// The header row (without its newline).
-pub const CSV_HEADER: &str =
-    "t_us,seq,state,target,mu,normal_n,tangential_n,amp,freq_hz,overruns,lost,lock,phase_deg";
+pub const CSV_HEADER: &str = "t_us,seq,state,target,mu,normal_n,tangential_n,amp,freq_hz,overruns,lost,lock,phase_deg,\
+     reach,reachable,resonance";
 
 /// The CSV text of `records`.
 pub fn telemetry_csv(records: &[TelemetryRecord]) -> String {
@@ -32,7 +34,7 @@ pub fn telemetry_csv(records: &[TelemetryRecord]) -> String {
     for r in records {
         let _ = writeln!(
             text,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.time_us,
             r.seq,
             r.reading.state.name(),
@@ -47,6 +49,9 @@ pub fn telemetry_csv(records: &[TelemetryRecord]) -> String {
             r.lock.map_or("none", |lock| lock.name()),
             r.phase_mdeg
                 .map_or_else(|| "undefined".to_string(), |m| fixed(i64::from(m), 3)),
+            r.reach.state.name(),
+            target_text(r.reach.reachable.as_ref()),
+            r.reach.resonance.map_or("unknown", |d| d.name()),
         );
     }
     text
@@ -76,13 +81,14 @@ mod tests {
             lost_records: 3,
             lock: None,
             phase_mdeg: None,
+            reach: sonolube::protocol::RunReach::UNKNOWN,
         };
         let text = telemetry_csv(&[record, record]);
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines.len(), 3);
         assert_eq!(lines[0], CSV_HEADER);
         // Same values, same text as the telemetry line itself.
-        let mut wire = heapless::String::<256>::new();
+        let mut wire = heapless::String::<{ sonolube::protocol::TELEMETRY_CAPACITY }>::new();
         format_telemetry(&record, &mut wire).unwrap();
         let values: Vec<&str> = wire
             .trim_end()

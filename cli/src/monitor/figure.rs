@@ -96,6 +96,7 @@ mod tests {
             lost_records: 0,
             lock: None,
             phase_mdeg: None,
+            reach: sonolube::protocol::RunReach::UNKNOWN,
         }
     }
 

@@ -189,7 +189,7 @@ mod tests {
 
     const TEL: &[u8] = b"tel t_us=1000 seq=1 state=idle target=none mu=0.240000 normal_n=40.000 \
         tangential_n=9.600 amp=0.000000 freq_hz=40000.00 overruns=0 lost=0 lock=pinned \
-        phase_deg=undefined";
+        phase_deg=undefined reach=ok reachable=none resonance=near";
 
     fn inbox() -> Inbox {
         Inbox::new(DEFAULT_RECORD_CAPACITY)

@@ -38,6 +38,12 @@ pub struct Status {
     pub lock: Option<String>,
     /// The motional current's phase to the voltage, mdeg; `None` for `undefined`.
     pub phase_mdeg: Option<i32>,
+    /// `ok` or `target-unreachable` (protocol 2).
+    pub reach: String,
+    /// With `target-unreachable`, the value the full drive reaches now.
+    pub reachable: Option<Target>,
+    /// `near`, `far` or `unknown`: the drive frequency against the resonance.
+    pub resonance: String,
     /// Keys the reply carried that this protocol version does not document.
     pub extra_keys: Vec<String>,
 }
@@ -54,7 +60,7 @@ pub struct Version {
 }
 
 /// The keys of a `status` reply, in order.
-pub const STATUS_KEYS: [&str; 13] = [
+pub const STATUS_KEYS: [&str; 16] = [
     "state",
     "scene",
     "target",
@@ -68,6 +74,9 @@ pub const STATUS_KEYS: [&str; 13] = [
     "fault",
     "lock",
     "phase_deg",
+    "reach",
+    "reachable",
+    "resonance",
 ];
 
 /// The payload of an `ok` reply, or what the reply was instead.
@@ -124,6 +133,12 @@ pub fn decode_status(reply: &ReplyLine) -> Result<Status, String> {
             "undefined" => None,
             _ => Some(number(&payload, "phase_deg", 3, decode_i32)?),
         },
+        reach: field(&payload, "reach")?.to_string(),
+        reachable: {
+            let text = field(&payload, "reachable")?;
+            decode_target(text).map_err(|e| format!("reachable={text}: {e:?}"))?
+        },
+        resonance: field(&payload, "resonance")?.to_string(),
         extra_keys: payload
             .pairs()
             .map(|(key, _)| key)
@@ -186,7 +201,8 @@ mod tests {
         let status = decode_status(&reply(
             "ok state=running scene=demo target=coef:0.150000 mu=0.151000 normal_n=40.000 \
              tangential_n=-6.040 amp=0.523000 freq_hz=40000.00 overruns=0 lost=3 fault=none \
-             lock=locked phase_deg=-0.250",
+             lock=locked phase_deg=-0.250 reach=target-unreachable reachable=coef:0.180000 \
+             resonance=near",
         ))
         .unwrap();
         assert_eq!(status.state, SupervisorState::Running);
@@ -200,6 +216,9 @@ mod tests {
         assert_eq!(status.fault, None);
         assert_eq!(status.lock.as_deref(), Some("locked"));
         assert_eq!(status.phase_mdeg, Some(-250));
+        assert_eq!(status.reach, "target-unreachable");
+        assert_eq!(status.reachable, Some(Target::Coef { coef_ppm: 180_000 }));
+        assert_eq!(status.resonance, "near");
         assert!(status.extra_keys.is_empty());
     }
 
@@ -207,7 +226,7 @@ mod tests {
     fn missing_or_bad_fields_are_named() {
         let full = "ok state=idle scene=none target=none mu=0.240000 normal_n=40.000 \
                     tangential_n=9.600 amp=0.000000 freq_hz=40000.00 overruns=0 lost=0 fault=none \
-                    lock=pinned phase_deg=undefined";
+                    lock=pinned phase_deg=undefined reach=ok reachable=none resonance=unknown";
         assert!(decode_status(&reply(full)).is_ok());
         for key in STATUS_KEYS {
             let without: Vec<&str> = full

@@ -141,6 +141,7 @@ mod tests {
             lost_records: lost,
             lock: None,
             phase_mdeg: None,
+            reach: sonolube::protocol::RunReach::UNKNOWN,
         }
     }
 

@@ -208,6 +208,7 @@ mod tests {
             lost_records: 0,
             lock: None,
             phase_mdeg: None,
+            reach: sonolube::protocol::RunReach::UNKNOWN,
         }
     }
 

@@ -112,9 +112,10 @@ pub fn flags(
             flags.insert(
                 "f",
                 format!(
-                    "f = {f} Hz is outside the {:.0}-{:.0} kHz drive band these models are built \
+                    "f = {} Hz is outside the {:.0}-{:.0} kHz drive band these models are built \
                      for (the PMN-PT stack, seed 003 Table 1; the firmware's drive refuses it): \
                      the numbers are the formula's, not the stack's",
+                    short_number(f),
                     low / 1e3,
                     high / 1e3
                 ),
@@ -128,6 +129,25 @@ pub fn flags(
 }
 
 /// One side's value of `key` outside `[low, high]`; the sides that show it.
+/// `x` as a person reads it in a flag: as Rust writes it when that takes at most 12
+/// characters (`39999.5`, `0.25`), else in scientific form with at most 4 decimals of
+/// mantissa (`1e-300`, `1.2346e7`): never hundreds of digits (issue 26: `f=1e-300` was spelled
+/// out to more than 300 digits).
+pub fn short_number(x: f64) -> String {
+    let plain = format!("{x}");
+    if plain.len() <= 12 {
+        return plain;
+    }
+    let scientific = format!("{x:.4e}");
+    match scientific.split_once('e') {
+        Some((mantissa, exponent)) if mantissa.contains('.') => {
+            let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+            format!("{mantissa}e{exponent}")
+        }
+        _ => scientific,
+    }
+}
+
 fn sides_outside(
     key: &str,
     low: f64,
@@ -155,7 +175,10 @@ fn out_of_range(
         if let Some((sides, x)) = sides_outside("reduction_pct", 0.0, 100.0, fixed, reference) {
             found.push((
                 "reduction_pct",
-                format!("{sides}: reduction {x} % is outside [0, 100] %: {why}"),
+                format!(
+                    "{sides}: reduction {} % is outside [0, 100] %: {why}",
+                    short_number(x)
+                ),
             ));
         }
     };
@@ -182,8 +205,9 @@ fn out_of_range(
                 found.push((
                     "ratio",
                     format!(
-                        "{sides}: ratio {x} is outside [0, 1]: a Dahl steady state neither \
-                         exceeds nor reverses the Coulomb level (physics-notes §2)"
+                        "{sides}: ratio {} is outside [0, 1]: a Dahl steady state neither \
+                         exceeds nor reverses the Coulomb level (physics-notes §2)",
+                        short_number(x)
                     ),
                 ));
             }
@@ -199,13 +223,14 @@ fn out_of_range(
                 found.push((
                     "ratio",
                     format!(
-                        "{sides}: F'/F = {x} < 0 (a reduction above 100 %): the average friction \
+                        "{sides}: F'/F = {} < 0 (a reduction above 100 %): the average friction \
                          would push the slider forward, which friction cannot do. The u term \
                          dominates: u/delta = {u:.3e}, the longitudinal amplitude is {:.3e} times \
                          the static tangential deflection delta, so the contact would slip within \
                          each cycle, and the linear spring of seed 000 eq 15 (F' = K_t' (delta + \
                          u)) no longer holds. Away from the node the model is outside its \
                          validity (physics-notes §4)",
+                        short_number(x),
                         u.abs()
                     ),
                 ));
@@ -230,6 +255,15 @@ fn out_of_range(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_in_flags_are_short() {
+        assert_eq!(short_number(1e-300), "1e-300");
+        assert_eq!(short_number(-2.2e-14), "-2.2e-14");
+        assert_eq!(short_number(39_999.5), "39999.5");
+        assert_eq!(short_number(1.0 / 3.0), "3.3333e-1");
+        assert_eq!(short_number(1e300), "1e300");
+    }
 
     #[test]
     fn every_undefinable_output_has_one_reason() {

@@ -134,3 +134,20 @@ fn headroom(scene: &Scene<'_>) -> String {
          {by_current:.3e}"
     )
 }
+
+/// Why the host could not measure the model variants over a scene file's contents, naming the
+/// scene key behind `error` where it is known (issue 26: a velocity range through zero was
+/// reported as `reference DahlSteady: no sliding (v = 0)`, naming no key).
+pub fn cannot_select(scene: &Scene<'_>, error: &str) -> String {
+    let c = &scene.contents;
+    if error.contains("no sliding") || error.contains("v = 0") {
+        format!(
+            "contents.velocity_range_m_per_s = [{}, {}]: the model variants are measured over \
+             this range, and at v = 0 there is no sliding, so the friction ratio is undefined \
+             ({error}); a scene file measured on the host needs a range of one sign",
+            c.velocity_min_m_per_s, c.velocity_max_m_per_s
+        )
+    } else {
+        format!("the model variants cannot be measured over the scene's contents: {error}")
+    }
+}

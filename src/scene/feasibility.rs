@@ -1,0 +1,537 @@
+//! Whether a scene can work, judged before it runs (issue 26): the values of a scene file can
+//! each be in range and still ask for what the physics or the controller cannot give.
+//!
+//! [`check`] weighs a scene against the controller's own model (the one the station runs) and
+//! the controller's tuning ([`crate::control::controller_settings`]):
+//!
+//! - **target against reach**: the friction ratio each target asks for (1 - reduction, or the
+//!   coefficient or force over the controller's natural friction at that load and speed),
+//!   against the lowest ratio the model gives at the drive's ceiling (the actuator ratings'
+//!   [`AmplitudeLimit`]), times the transducer's gain at the drive frequency
+//!   `1 / sqrt(1 + (2 Q (f - f0) / f0)^2)` (a `freq auto` scene drives on the resonance). A
+//!   target the full drive misses by more than the scene's band is refused; one it misses by
+//!   less is a warning (the run holds the drive at its limit and passes only within the band).
+//!   A target above the natural friction is out of reach the same way: vibration only lowers
+//!   friction.
+//! - **sliding speed against the sliding threshold**: the controller's sliding detector
+//!   switches the loop on above `sliding_on_m_s` (1 mm/s); a scene that never slides faster
+//!   never starts its loop, and a criterion window where it is slower judges a loop that is
+//!   off.
+//! - **cell noise against the accuracy**: the RMS friction error the cells' noise (and the
+//!   converter's quantisation) alone predicts through the controller's force filter
+//!   (a first-order low-pass `y += alpha (x - y)` passes `alpha / (2 - alpha)` of a white
+//!   noise's variance), relative to the smallest friction the target asks for with the drive
+//!   on. Above the scene's band it is refused; above half the band it is a warning (the model
+//!   error and the noise share the band).
+//!
+//! The control rate's range is the schema's (`sonolube_scene_types::CONTROL_RATE_RANGE_HZ`,
+//! the one source the loader and the controller's gains share); its period budget is checked
+//! with the model variant (`crate::variant`).
+//!
+//! Configuration only (`f64`, once per scene); no allocation, so a board runs it at `scene`.
+
+use core::fmt;
+
+use crate::control::{AmplitudeLimit, Settings, controller_settings};
+use crate::fx::{Q1_31, Q8_24, Q16_16};
+use crate::model::{FrictionModel, ModelError, OperatingPoint};
+use crate::protocol::Target;
+use crate::scene::{Criterion, Scene, interpolate, target_at};
+
+/// Instants sampled per target segment and per criterion window.
+const SAMPLES: u32 = 64;
+
+/// How bad a finding is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Severity {
+    /// The scene may work, with no margin: the run says so.
+    Warn,
+    /// The scene cannot work as written: it is refused.
+    Refuse,
+}
+
+impl Severity {
+    /// `warning` or `refused`.
+    pub const fn word(self) -> &'static str {
+        match self {
+            Severity::Warn => "warning",
+            Severity::Refuse => "refused",
+        }
+    }
+}
+
+/// What a finding is about, with the numbers that fail.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Cause {
+    /// A target asks for a friction ratio the full drive does not reach (or one above the
+    /// natural friction).
+    TargetOutOfReach {
+        /// Index of the target point in `profiles.target`.
+        point: usize,
+        /// The target.
+        target: Target,
+        /// Time of the worst instant, s.
+        at_s: f64,
+        /// Friction ratio F'/F the target asks for there.
+        needed_ratio: f64,
+        /// Lowest friction ratio the controller's model gives at the drive's ceiling there.
+        reachable_ratio: f64,
+        /// The drive's ceiling, fraction of full scale, times the transducer's gain at the
+        /// drive frequency.
+        drive: f64,
+    },
+    /// The sliding speed stays at or below the sliding threshold.
+    NoSliding {
+        /// Start of the span judged, s.
+        from_s: f64,
+        /// End of the span judged, s.
+        to_s: f64,
+        /// Fraction of the span below the threshold, [0, 1].
+        fraction_below: f64,
+        /// Highest speed in the span, m/s.
+        top_speed_m_per_s: f64,
+        /// The controller's sliding threshold, m/s.
+        threshold_m_per_s: f64,
+    },
+    /// The cells' noise alone predicts an RMS friction error near or above the band.
+    Noise {
+        /// Predicted RMS error, % of the smallest target friction.
+        predicted_pct: f64,
+        /// The scene's band, `accuracy.friction_pct`.
+        band_pct: f64,
+        /// The smallest friction the target asks for with the drive on, N.
+        friction_n: f64,
+        /// The tangential cell's filtered noise, N RMS.
+        tangential_noise_n: f64,
+    },
+    /// The controller's model could not be evaluated at the scene's operating points.
+    Model(ModelError),
+}
+
+/// One thing that cannot, or may not, work, with the scene key it comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Finding {
+    /// Refused or a warning.
+    pub severity: Severity,
+    /// The scene file's key (for a target: the point's key is written with its index).
+    pub field: &'static str,
+    /// What fails, with its numbers.
+    pub cause: Cause,
+}
+
+impl Finding {
+    /// What fails, in a few words (at most [`crate::protocol::MAX_REASON_LEN`] bytes), for an
+    /// `err` reply; the numbers are in the [`fmt::Display`] text.
+    pub const fn summary(&self) -> &'static str {
+        match self.cause {
+            Cause::TargetOutOfReach { .. } => "the target is beyond the drive's reach",
+            Cause::NoSliding { .. } => "the speed is below the sliding threshold",
+            Cause::Noise { .. } => "the cells' noise exceeds the accuracy band",
+            Cause::Model(_) => "the controller's model fails over the scene",
+        }
+    }
+}
+
+impl fmt::Display for Finding {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: ", self.severity.word())?;
+        match self.cause {
+            Cause::TargetOutOfReach {
+                point,
+                target,
+                at_s,
+                needed_ratio,
+                reachable_ratio,
+                drive,
+            } => {
+                let (key, value) = match target {
+                    Target::Reduction { reduction_mpct } => {
+                        ("reduction_pct", f64::from(reduction_mpct) * 1e-3)
+                    }
+                    Target::Coef { coef_ppm } => ("coef", f64::from(coef_ppm) * 1e-6),
+                    Target::Force { force_mn } => ("force_n", f64::from(force_mn) * 1e-3),
+                };
+                write!(
+                    f,
+                    "profiles.target[{point}].{key} = {value}: asks for {:.2} % of the natural \
+                     friction at t = {at_s:.4} s; the controller's model reaches at best {:.2} % \
+                     (reduction {:.2} %) with the drive at {:.3} of full scale",
+                    100.0 * needed_ratio,
+                    100.0 * reachable_ratio,
+                    100.0 * (1.0 - reachable_ratio),
+                    drive
+                )?;
+                if needed_ratio > 1.0 {
+                    write!(f, " (vibration only lowers friction)")?;
+                }
+                Ok(())
+            }
+            Cause::NoSliding {
+                from_s,
+                to_s,
+                fraction_below,
+                top_speed_m_per_s,
+                threshold_m_per_s,
+            } => write!(
+                f,
+                "{}: from {from_s} s to {to_s} s the speed is at most {top_speed_m_per_s:.6} m/s, \
+                 {:.0} % of the time below the sliding threshold {threshold_m_per_s} m/s: the \
+                 loop does not run without sliding",
+                self.field,
+                100.0 * fraction_below
+            ),
+            Cause::Noise {
+                predicted_pct,
+                band_pct,
+                friction_n,
+                tangential_noise_n,
+            } => write!(
+                f,
+                "{}: the cells' noise alone predicts {predicted_pct:.2} % RMS friction error \
+                 through the controller's force filter ({tangential_noise_n:.3e} N RMS against \
+                 {friction_n:.4} N of target friction), against accuracy.friction_pct = \
+                 {band_pct} %",
+                self.field
+            ),
+            Cause::Model(error) => write!(
+                f,
+                "{}: the controller's model cannot be evaluated over the scene: {error}",
+                self.field
+            ),
+        }
+    }
+}
+
+/// Most findings [`check`] returns: one per check.
+pub const MAX_FINDINGS: usize = 4;
+
+/// The findings of [`check`], worst of each check.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Feasibility {
+    findings: heapless::Vec<Finding, MAX_FINDINGS>,
+}
+
+impl Feasibility {
+    /// Every finding, refusals and warnings.
+    pub fn findings(&self) -> &[Finding] {
+        &self.findings
+    }
+
+    /// The first refusal, if any: the scene cannot work.
+    pub fn refusal(&self) -> Option<&Finding> {
+        self.findings
+            .iter()
+            .find(|f| f.severity == Severity::Refuse)
+    }
+
+    /// The warnings.
+    pub fn warnings(&self) -> impl Iterator<Item = &Finding> {
+        self.findings
+            .iter()
+            .filter(|f| f.severity == Severity::Warn)
+    }
+
+    fn push(&mut self, finding: Option<Finding>) {
+        if let Some(finding) = finding {
+            // At most one finding per check, MAX_FINDINGS checks.
+            let _ = self.findings.push(finding);
+        }
+    }
+}
+
+/// Judges `scene` against `model`, the friction model its controller runs (the station's:
+/// [`crate::station::Station::model`]). See the module documentation for the rules.
+pub fn check<M: FrictionModel + ?Sized>(scene: &Scene<'_>, model: &M) -> Feasibility {
+    let settings = controller_settings(scene);
+    let mut result = Feasibility::default();
+    result.push(sliding(scene, &settings));
+    result.push(reach(scene, &settings, model));
+    result.push(noise(scene, &settings));
+    result
+}
+
+/// The transducer's vibration gain at the drive frequency, at time `t_s` (1 on resonance).
+pub fn drive_gain(scene: &Scene<'_>, t_s: f64) -> f64 {
+    let transducer = &scene.transducer;
+    if transducer.shift.freq_auto {
+        return 1.0;
+    }
+    let f0 = transducer.resonance_hz + transducer.drift_hz_per_s * t_s;
+    let detuning = 2.0 * transducer.quality_factor * (transducer.drive_hz - f0) / f0;
+    1.0 / libm::sqrt(1.0 + detuning * detuning)
+}
+
+/// The friction ratio `target` asks of a contact whose natural coefficient is `mu` under
+/// `load_n`.
+fn needed_ratio(target: Target, mu: f64, load_n: f64) -> f64 {
+    match target {
+        Target::Reduction { reduction_mpct } => 1.0 - f64::from(reduction_mpct) * 1e-5,
+        Target::Coef { coef_ppm } => f64::from(coef_ppm) * 1e-6 / mu,
+        Target::Force { force_mn } => f64::from(force_mn) * 1e-3 / (mu * load_n),
+    }
+}
+
+/// The instants `from_s + (to_s - from_s) k / SAMPLES`, k = 0 ..= SAMPLES.
+fn instants(from_s: f64, to_s: f64) -> impl Iterator<Item = f64> {
+    (0..=SAMPLES).map(move |k| from_s + (to_s - from_s) * f64::from(k) / f64::from(SAMPLES))
+}
+
+fn speed_at(scene: &Scene<'_>, t_s: f64) -> f64 {
+    f64::from(libm::fabsf(interpolate(
+        scene.sliding_velocity_m_per_s,
+        t_s as f32,
+    )))
+}
+
+fn sliding(scene: &Scene<'_>, settings: &Settings) -> Option<Finding> {
+    let threshold = settings.sliding_on_m_s;
+    let field = "profiles.sliding_velocity_m_per_s";
+    let span = |from_s: f64, to_s: f64| {
+        let (mut below, mut top) = (0u32, 0.0f64);
+        for t in instants(from_s, to_s) {
+            let speed = speed_at(scene, t);
+            top = top.max(speed);
+            below += u32::from(speed <= threshold);
+        }
+        Cause::NoSliding {
+            from_s,
+            to_s,
+            fraction_below: f64::from(below) / f64::from(SAMPLES + 1),
+            top_speed_m_per_s: top,
+            threshold_m_per_s: threshold,
+        }
+    };
+    let whole = span(0.0, scene.duration_s);
+    if let Cause::NoSliding {
+        top_speed_m_per_s, ..
+    } = whole
+        && top_speed_m_per_s <= threshold
+    {
+        return Some(Finding {
+            severity: Severity::Refuse,
+            field,
+            cause: whole,
+        });
+    }
+    // A window judged on a loop that is off there: refused when off throughout, a warning
+    // when off for part of it (a reversal).
+    let mut worst: Option<Finding> = None;
+    for criterion in scene.criteria {
+        let (from_s, to_s) = match *criterion {
+            Criterion::SteadyRmsError { from_s, to_s, .. }
+            | Criterion::TrackingError { from_s, to_s, .. } => (from_s, to_s),
+            _ => continue,
+        };
+        let cause = span(from_s, to_s);
+        let Cause::NoSliding {
+            fraction_below,
+            top_speed_m_per_s,
+            ..
+        } = cause
+        else {
+            continue;
+        };
+        let severity = if top_speed_m_per_s <= threshold {
+            Severity::Refuse
+        } else if fraction_below > 0.0 {
+            Severity::Warn
+        } else {
+            continue;
+        };
+        if worst.is_none_or(|w| severity > w.severity) {
+            worst = Some(Finding {
+                severity,
+                field,
+                cause,
+            });
+        }
+    }
+    worst
+}
+
+fn reach<M: FrictionModel + ?Sized>(
+    scene: &Scene<'_>,
+    settings: &Settings,
+    model: &M,
+) -> Option<Finding> {
+    let ceiling = match AmplitudeLimit::new(&settings.actuator) {
+        Ok(limit) => limit.max_amplitude.to_f64(),
+        // No headroom is the controller's own refusal, with its own message.
+        Err(_) => return None,
+    };
+    let band = scene.accuracy.friction_pct / 100.0;
+    let threshold = settings.sliding_on_m_s;
+    let mut worst: Option<(f64, Finding)> = None;
+    for (index, point) in scene.target.iter().enumerate() {
+        let end = scene
+            .target
+            .get(index + 1)
+            .map_or(scene.duration_s, |next| next.at_s);
+        for t in instants(point.at_s, end.max(point.at_s)) {
+            // Just before the next point its own target takes over.
+            let t = if t >= end && end > point.at_s {
+                end - 1e-9
+            } else {
+                t
+            };
+            let Some(target) = target_at(scene.target, t as f32) else {
+                continue;
+            };
+            if target == (Target::Reduction { reduction_mpct: 0 }) {
+                continue;
+            }
+            let speed = speed_at(scene, t);
+            let load = f64::from(interpolate(scene.normal_load_n, t as f32));
+            if speed <= threshold || load <= settings.min_normal_force_n {
+                continue;
+            }
+            let mu = scene.controller.natural_coefficient(speed);
+            let needed = needed_ratio(target, mu, load);
+            let drive = ceiling * drive_gain(scene, t);
+            let operating = OperatingPoint {
+                normal_force: Q16_16::from_f64_saturating(load).value,
+                sliding_velocity: Q8_24::from_f64_saturating(speed).value,
+            };
+            let amplitude = Q1_31::from_f64_saturating(drive).value;
+            let reachable = match model.ratio(&operating, amplitude) {
+                Ok(ratio) => ratio.to_f64(),
+                Err(error) => {
+                    return Some(Finding {
+                        severity: Severity::Refuse,
+                        field: "controller",
+                        cause: Cause::Model(error),
+                    });
+                }
+            };
+            // Relative miss of the friction: below reach (needed < reachable) or above the
+            // natural friction (needed > 1).
+            let miss = if needed < reachable {
+                (reachable - needed) / needed
+            } else if needed > 1.0 {
+                (needed - 1.0) / needed
+            } else {
+                continue;
+            };
+            let severity = if miss > band {
+                Severity::Refuse
+            } else {
+                Severity::Warn
+            };
+            let field = match target {
+                Target::Reduction { .. } => "profiles.target.reduction_pct",
+                Target::Coef { .. } => "profiles.target.coef",
+                Target::Force { .. } => "profiles.target.force_n",
+            };
+            let finding = Finding {
+                severity,
+                field,
+                cause: Cause::TargetOutOfReach {
+                    point: index,
+                    target,
+                    at_s: t,
+                    needed_ratio: needed,
+                    reachable_ratio: if needed > 1.0 { 1.0 } else { reachable },
+                    drive,
+                },
+            };
+            if worst.is_none_or(|(m, _)| miss > m) {
+                worst = Some((miss, finding));
+            }
+        }
+    }
+    worst.map(|(_, finding)| finding)
+}
+
+/// Per-sample noise of a cell, N RMS: its Gaussian noise and its converter's quantisation
+/// (one step over sqrt 12).
+fn cell_noise_n(cell: &crate::scene::LoadCell) -> f64 {
+    let gaussian = cell.noise_rms_pct_fs / 100.0 * cell.full_scale_n;
+    let step = 2.0 * cell.full_scale_n / libm::ldexp(1.0, i32::from(cell.adc_bits));
+    libm::sqrt(gaussian * gaussian + step * step / 12.0)
+}
+
+/// The share of a white noise's RMS that a first-order low-pass of `bandwidth_hz` sampled at
+/// `rate_hz` passes: sqrt(alpha / (2 - alpha)), with the controller's alpha
+/// ([`crate::control::LowPassCoef::from_bandwidth`]).
+fn filter_rms_gain(bandwidth_hz: f64, rate_hz: f64) -> f64 {
+    let c = libm::cos(core::f64::consts::TAU * bandwidth_hz / rate_hz);
+    let p = 2.0 - c;
+    let alpha = 1.0 - (p - libm::sqrt(p * p - 1.0));
+    libm::sqrt(alpha / (2.0 - alpha))
+}
+
+fn noise(scene: &Scene<'_>, settings: &Settings) -> Option<Finding> {
+    let rate = 1.0 / settings.period_s;
+    let tangential = cell_noise_n(&scene.tangential_cell)
+        * filter_rms_gain(settings.tangential_bandwidth_hz, rate);
+    let normal =
+        cell_noise_n(&scene.normal_cell) * filter_rms_gain(settings.normal_bandwidth_hz, rate);
+    let band = scene.accuracy.friction_pct;
+    let mut worst: Option<(f64, Cause, &'static str)> = None;
+    for (index, point) in scene.target.iter().enumerate() {
+        let end = scene
+            .target
+            .get(index + 1)
+            .map_or(scene.duration_s, |next| next.at_s);
+        for t in instants(point.at_s, end.max(point.at_s)) {
+            let Some(target) = target_at(scene.target, t as f32) else {
+                continue;
+            };
+            let speed = speed_at(scene, t);
+            let load = f64::from(interpolate(scene.normal_load_n, t as f32));
+            if speed <= settings.sliding_on_m_s || load <= settings.min_normal_force_n {
+                continue;
+            }
+            let mu = scene.controller.natural_coefficient(speed);
+            let needed = needed_ratio(target, mu, load);
+            // Natural friction is held with the drive off: the noise moves no drive.
+            if needed >= 1.0 {
+                continue;
+            }
+            let friction = needed * mu * load;
+            // The coefficient is F_t / F_n: the relative noises add in quadrature.
+            let predicted = 100.0
+                * libm::sqrt(
+                    (tangential / friction) * (tangential / friction)
+                        + (normal / load) * (normal / load),
+                );
+            let field = if tangential / friction >= normal / load {
+                "sensors.tangential.noise_rms_pct_fs"
+            } else {
+                "sensors.normal.noise_rms_pct_fs"
+            };
+            if worst.is_none_or(|(p, _, _)| predicted > p) {
+                worst = Some((
+                    predicted,
+                    Cause::Noise {
+                        predicted_pct: predicted,
+                        band_pct: band,
+                        friction_n: friction,
+                        tangential_noise_n: tangential,
+                    },
+                    field,
+                ));
+            }
+        }
+    }
+    let (predicted, cause, field) = worst?;
+    let severity = if predicted > band {
+        Severity::Refuse
+    } else if predicted > band / 2.0 {
+        Severity::Warn
+    } else {
+        return None;
+    };
+    Some(Finding {
+        severity,
+        field,
+        cause,
+    })
+}
+
+#[cfg(test)]
+#[path = "feasibility_tests.rs"]
+mod tests;
