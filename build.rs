@@ -11,6 +11,9 @@
 //! left-out family (a horn vibrates the contact normally: the cube family). The plant model is
 //! the simulation's (`sonolube-sim`, which takes every family); a board drives a real contact.
 //!
+//! `SONOLUBE_EXTRA_SCENES=DIR` compiles the scene files of `DIR` in as well (test scenes run in
+//! QEMU, `cli/tests/scenes/`); a name that is also in `scenes/` fails the build.
+//!
 //! **Cube tables in flash** (issue 24, item 5). A scene whose variant selection
 //! (`sonolube::variant::select`) picks a tabulated cube model (`cube ep T=17x17`, ...) used to
 //! build its table at scene start: 316,120 Cortex-M4 instructions for 17 x 17 nodes, 18 to 46
@@ -73,6 +76,26 @@ fn main() {
         println!("cargo::rerun-if-changed={}", file.display());
     }
     let mut scenes = scene_toml::load_dir(&scenes_dir).unwrap_or_else(|error| fail(&error));
+    // Test scenes compiled in on request (`SONOLUBE_EXTRA_SCENES=DIR`): a firmware that runs a
+    // scene file of a test directory (`cli/tests/scenes/`) in QEMU, never a shipped build.
+    println!("cargo::rerun-if-env-changed=SONOLUBE_EXTRA_SCENES");
+    if let Some(extra) = std::env::var_os("SONOLUBE_EXTRA_SCENES").filter(|d| !d.is_empty()) {
+        let extra = PathBuf::from(extra);
+        println!("cargo::rerun-if-changed={}", extra.display());
+        for file in scene_toml::scene_files(&extra).unwrap_or_else(|error| fail(&error)) {
+            println!("cargo::rerun-if-changed={}", file.display());
+        }
+        for scene in scene_toml::load_dir(&extra).unwrap_or_else(|error| fail(&error)) {
+            if scenes.iter().any(|s| s.name == scene.name) {
+                fail(&format!(
+                    "{}: scene {:?} is also in scenes/",
+                    extra.display(),
+                    scene.name
+                ));
+            }
+            scenes.push(scene);
+        }
+    }
     scenes.retain(|scene| {
         in_build(scene.controller.kind) && (scene.horn.is_none() || feature("CUBE"))
     });

@@ -352,7 +352,11 @@ fn the_model_line_names_the_selected_variant_and_its_reason() {
                 format!("over {points} points"),
             ],
             Reason::NotMeasured { .. } => panic!("{}: built-in scenes are measured", built.name),
+            Reason::Overruns { .. } => panic!("{}: a built-in scene fits its period", built.name),
         };
+        let period = selection.period;
+        assert!(period.fits(), "{line}");
+        assert!(line.contains(&format!("{period}")), "{line}");
         for number in numbers {
             assert!(line.contains(&number), "{number:?} not in {line}");
         }

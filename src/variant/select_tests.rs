@@ -4,6 +4,7 @@
 
 use super::*;
 use crate::scene::{ModelSpec, find};
+use crate::variant::budget::{G474, QEMU};
 
 fn leak<T>(items: Vec<T>) -> &'static [T] {
     Box::leak(items.into_boxed_slice())
@@ -34,6 +35,18 @@ fn measured(
                     reference,
                     max_error,
                     points: 120,
+                })
+                .collect(),
+        ),
+        // Every variant's control step well within any period (2,500 instructions at 100 kHz
+        // on the qemu board): the rules under test are the accuracy's.
+        steps: leak(
+            costs
+                .iter()
+                .map(|&(variant, _)| StepCost {
+                    variant,
+                    mean: 900.0,
+                    longest: 1000,
                 })
                 .collect(),
         ),
@@ -360,7 +373,7 @@ fn the_committed_table_applies_only_to_the_scenes_it_measured() {
     let base = select(horn);
     let cost = |s: &Selection| match s.reason {
         Reason::Meets { instructions, .. } | Reason::NoneMeets { instructions, .. } => instructions,
-        Reason::NotMeasured { .. } => f32::INFINITY,
+        Reason::NotMeasured { .. } | Reason::Overruns { .. } => f32::INFINITY,
     };
     let same = [
         Scene {
@@ -388,4 +401,116 @@ fn the_committed_table_applies_only_to_the_scenes_it_measured() {
         assert!(s.variant.is_some(), "{s}");
         assert!(cost(&s) <= cost(&base), "{s} vs {base}");
     }
+}
+
+/// Measurements whose steps are `steps` (variant, longest step) instead.
+fn with_steps(m: Measurements, steps: &[(&'static str, u32)]) -> Measurements {
+    Measurements {
+        steps: leak(
+            steps
+                .iter()
+                .map(|&(variant, longest)| StepCost {
+                    variant,
+                    mean: longest as f32,
+                    longest,
+                })
+                .collect(),
+        ),
+        ..m
+    }
+}
+
+/// The period: the cheapest accurate variant whose longest step fits wins; accurate ones that
+/// all overrun refuse the scene, naming the budget and the excess; the same scene fits the
+/// qemu board's 25,000 instructions at 10 kHz and not the G474's 12,500.
+#[test]
+fn the_choice_fits_the_control_period_or_the_scene_is_refused() {
+    let scene = *find("load-ramp").unwrap();
+    let base = measured(
+        &cube_costs(),
+        &[
+            ("load-ramp", "cube el N=4", EP, 0.02),
+            ("load-ramp", "cube el N=8", EP, 0.02),
+            ("load-ramp", "cube ep N=4", EP, 0.004),
+            ("load-ramp", "cube ep N=8", EP, 0.001),
+            ("load-ramp", "cube ep N=16", EP, 0.0001),
+        ],
+    );
+    let steps = [
+        ("cube el N=4", 900),
+        ("cube el N=8", 1_200),
+        ("cube ep N=4", 30_000),
+        ("cube ep N=8", 14_000),
+        ("cube ep N=16", 20_000),
+    ];
+    let m = with_steps(base, &steps);
+    // Budget 0.5 %: ep N=4 is the cheapest accurate one but overruns 25,000; N=8 fits.
+    let s = select_for(&scene, &m, &QEMU);
+    assert_eq!(s.variant.map(|v| v.name), Some("cube ep N=8"), "{s}");
+    assert!(!s.refused());
+    assert_eq!(s.period.budget, 25_000);
+    assert_eq!(s.period.step_longest, Some(14_000));
+    assert!(
+        std::format!("{s}").contains("period budget 25,000 instructions (qemu)"),
+        "{s}"
+    );
+    // On the G474 (12,500 at 10 kHz) no accurate variant fits: refused, by 1,500.
+    let g = select_for(&scene, &m, &G474);
+    assert!(g.refused(), "{g}");
+    assert!(matches!(g.reason, Reason::Overruns { accurate: true, .. }));
+    assert_eq!(g.variant.map(|v| v.name), Some("cube ep N=8"));
+    let line = std::format!("{g}");
+    assert!(line.contains("REFUSED"), "{line}");
+    assert!(
+        line.contains("period budget 12,500 instructions (nucleo-g474re at 10000 Hz)"),
+        "{line}"
+    );
+    assert!(line.contains("exceeds it by 1,500 instructions"), "{line}");
+    assert!(g.build(&scene).is_err());
+    // Ten times the rate: 2,500 on qemu; nothing accurate fits.
+    let fast = Scene {
+        control_rate_hz: 100_000.0,
+        ..scene
+    };
+    let f = select_for(&fast, &m, &QEMU);
+    assert!(f.refused() && f.period.budget == 2_500, "{f}");
+    // A variant without a measured step is no candidate.
+    let partial = with_steps(base, &steps[..2]);
+    let p = select_for(&scene, &partial, &QEMU);
+    assert!(
+        p.variant.is_none_or(|v| v.name.starts_with("cube el")),
+        "{p}"
+    );
+}
+
+/// A scene nothing was measured for runs its own model at the default knob only when that
+/// model's measured step fits.
+#[test]
+fn an_unmeasured_scene_is_refused_when_its_own_model_overruns() {
+    let reference = *find("reference").unwrap();
+    let mine = Scene {
+        name: "not-built-in",
+        controller: ModelSpec {
+            kind: ModelKind::Dahl,
+            ..reference.controller
+        },
+        ..reference
+    };
+    let m = with_steps(
+        measured(&[], &[]),
+        &[("Dahl steady N=64", 891_440), ("Coulomb ratio", 3_400)],
+    );
+    let s = not_measured(&mine, &m, &QEMU);
+    assert!(s.refused(), "{s}");
+    assert!(
+        std::format!("{s}").contains("exceeds it by 866,440 instructions"),
+        "{s}"
+    );
+    let coulomb = Scene {
+        controller: reference.controller,
+        ..mine
+    };
+    let c = not_measured(&coulomb, &m, &QEMU);
+    assert!(matches!(c.reason, Reason::NotMeasured { .. }), "{c}");
+    assert!(c.period.fits());
 }

@@ -296,7 +296,16 @@ pub fn run_forced(
                 .map_err(|e| format!("{}: {e}", variant.name))?;
             ClosedLoop::with_model(scene, model)
         }
-        None => ClosedLoop::with_selection(scene, crate::speed::table_rs::select_on_host(scene)?),
+        None => {
+            let selection = crate::speed::table_rs::select_on_host(scene)?;
+            if selection.refused() {
+                return Err(format!(
+                    "scene {} refused at load: controller {selection}",
+                    scene.name
+                ));
+            }
+            ClosedLoop::with_selection(scene, selection)
+        }
     };
     let mut sim = built.map_err(|e| why::cannot_run(scene, &e))?;
     let mut records = Vec::with_capacity(scene.step_count() as usize);
