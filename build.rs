@@ -55,6 +55,11 @@ mod scene {
     /// The scenes this build compiles in, set once by `main`.
     pub static BUILT: std::sync::OnceLock<Vec<Scene<'static>>> = std::sync::OnceLock::new();
 
+    /// The compiled-in scenes.
+    pub fn compiled() -> &'static [Scene<'static>] {
+        BUILT.get().map_or(&[], Vec::as_slice)
+    }
+
     /// The compiled-in scene named `name`.
     pub fn find(name: &str) -> Option<&'static Scene<'static>> {
         BUILT.get()?.iter().find(|scene| scene.name == name)

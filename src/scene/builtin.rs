@@ -16,6 +16,11 @@ use crate::protocol::Target;
 include!(concat!(env!("OUT_DIR"), "/scenes.rs"));
 include!(concat!(env!("OUT_DIR"), "/cube_tables.rs"));
 
+/// Every built-in scene ([`SCENES`]).
+pub fn compiled() -> &'static [Scene<'static>] {
+    SCENES
+}
+
 /// The built-in scene named `name` (the `scene <name>` command), if any.
 pub fn find(name: &str) -> Option<&'static Scene<'static>> {
     SCENES.iter().find(|scene| scene.name == name)

@@ -23,7 +23,7 @@ pub mod builtin;
 mod table;
 mod types;
 
-pub use builtin::{SCENES, cube_table_nodes, find};
+pub use builtin::{SCENES, compiled, cube_table_nodes, find};
 // The plain scene types, defined once in `sonolube-scene-types` and shared with the scene-file
 // loader (`scene-toml`), which reads them on the host and writes them for the build script.
 pub use sonolube_scene_types::{

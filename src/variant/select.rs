@@ -228,14 +228,33 @@ pub struct Selection {
 }
 
 /// The variant for `scene` from the committed measurements ([`table::MEASURED`]), which were
-/// taken on the built-in scenes: a scene that differs from the built-in scene of its name in
-/// anything the measurement depends on ([`measured_as_built_in`]) is not measured and keeps
-/// its own model ([`Reason::NotMeasured`]).
+/// taken on the built-in scenes: a scene is measured when a built-in scene with the same
+/// measurement inputs was ([`measured_twin`]: the scene itself, or one that differs only in
+/// what the errors do not depend on, such as its name, control rate or accuracy budget);
+/// otherwise it keeps its own model ([`Reason::NotMeasured`]).
 pub fn select(scene: &Scene<'_>) -> Selection {
-    if !measured_as_built_in(scene) {
-        return not_measured(scene, &table::MEASURED, &BOARD);
+    match measured_twin(scene, &table::MEASURED) {
+        Some(name) => select_from(&Scene { name, ..*scene }, &table::MEASURED),
+        None => not_measured(scene, &table::MEASURED, &BOARD),
     }
-    select_from(scene, &table::MEASURED)
+}
+
+/// The name under which `measured` holds `scene`'s errors: the built-in scene of its name when
+/// [`measured_as_built_in`], else the first built-in scene with the same measurement inputs
+/// (a test scene that is the `reference` scene at another control rate has the `reference`
+/// scene's errors: the grid and the models are the same). `None`: not measured.
+pub fn measured_twin(scene: &Scene<'_>, measured: &Measurements) -> Option<&'static str> {
+    let has_errors = |name: &str| measured.errors.iter().any(|e| e.scene == name);
+    if let Some(built) = crate::scene::find(scene.name)
+        && same_measurement_inputs(scene, built)
+        && has_errors(built.name)
+    {
+        return Some(built.name);
+    }
+    crate::scene::compiled()
+        .iter()
+        .find(|built| same_measurement_inputs(scene, built) && has_errors(built.name))
+        .map(|built| built.name)
 }
 
 /// Whether `scene` is, in everything the committed errors depend on, the built-in scene of its
@@ -245,9 +264,11 @@ pub fn select(scene: &Scene<'_>) -> Selection {
 /// with other contents or parameters, was not measured. The budget (`accuracy`) is not a
 /// measurement input: it is what the selection compares the errors with.
 pub fn measured_as_built_in(scene: &Scene<'_>) -> bool {
-    let Some(built) = crate::scene::find(scene.name) else {
-        return false;
-    };
+    crate::scene::find(scene.name).is_some_and(|built| same_measurement_inputs(scene, built))
+}
+
+/// Whether the committed errors of `built` are `scene`'s too (see [`measured_as_built_in`]).
+fn same_measurement_inputs(scene: &Scene<'_>, built: &Scene<'_>) -> bool {
     let controller = ModelSpec {
         kind: built.controller.kind,
         ..scene.controller

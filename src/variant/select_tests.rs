@@ -325,12 +325,16 @@ fn the_committed_table_applies_only_to_the_scenes_it_measured() {
     use crate::scene::{Accuracy, Contents, Transducer};
     let horn = find("horn-al-ss").unwrap();
     assert!(measured_as_built_in(horn));
+    // Another name only: not the built-in scene, but measured with its errors (its twin).
+    let copy = Scene {
+        name: "horn-copy",
+        ..*horn
+    };
+    assert!(!measured_as_built_in(&copy));
+    assert_eq!(measured_twin(&copy, &table::MEASURED), Some("horn-al-ss"));
+    assert_eq!(select(&copy).variant, select(horn).variant);
     // Anything the errors were measured with, changed: not measured, the scene's own model.
     let other = [
-        Scene {
-            name: "horn-copy",
-            ..*horn
-        },
         Scene {
             contents: Contents {
                 load_min_n: horn.contents.load_min_n + 20.0,
@@ -513,4 +517,36 @@ fn an_unmeasured_scene_is_refused_when_its_own_model_overruns() {
     let c = not_measured(&coulomb, &m, &QEMU);
     assert!(matches!(c.reason, Reason::NotMeasured { .. }), "{c}");
     assert!(c.period.fits());
+}
+
+/// A scene that differs from a measured built-in scene only in what the errors do not depend
+/// on (name, control rate) is measured with that scene's errors; one with another k_t is not.
+#[test]
+fn a_scene_with_a_measured_twin_uses_its_errors() {
+    let reference = *find("reference").unwrap();
+    let fast = Scene {
+        name: "ref-100khz",
+        control_rate_hz: 100_000.0,
+        ..reference
+    };
+    assert_eq!(measured_twin(&fast, &table::MEASURED), Some("reference"));
+    let s = select(&fast);
+    assert_eq!(s.variant, select(&reference).variant);
+    assert_eq!(s.period.budget, 2_500);
+    let stiffer = Scene {
+        controller: ModelSpec {
+            k_t_n_per_m: reference.controller.k_t_n_per_m.map(|k| 2.0 * k),
+            ..reference.controller
+        },
+        ..fast
+    };
+    assert_eq!(measured_twin(&stiffer, &table::MEASURED), None);
+    assert!(matches!(
+        select(&stiffer).reason,
+        Reason::NotMeasured { .. }
+            | Reason::Overruns {
+                error_pct: None,
+                ..
+            }
+    ));
 }

@@ -59,15 +59,16 @@ fn scene_errors(errors: &Errors) -> Vec<SceneError> {
 }
 
 /// The selection for `scene` as the host makes it when it loads the scene: the firmware's
-/// ([`sonolube::variant::select`], from the committed table) for a built-in scene as measured,
+/// ([`sonolube::variant::select`], from the committed table) for a scene whose measurement
+/// inputs a built-in scene's errors were measured with ([`measured_twin`]),
 /// and otherwise from the errors of the fixed-point candidates measured now against the
 /// reference for this scene's contents ([`super::errors::scene_errors`], a few seconds at
 /// most) with the committed instruction counts. Errors: the reference's (message).
 pub fn select_on_host(
     scene: &sonolube::scene::Scene<'_>,
 ) -> Result<sonolube::variant::Selection, String> {
-    use sonolube::variant::select::{measured_as_built_in, select_from};
-    if measured_as_built_in(scene) {
+    use sonolube::variant::select::{measured_twin, select_from};
+    if measured_twin(scene, &sonolube::variant::table::MEASURED).is_some() {
         return Ok(sonolube::variant::select(scene));
     }
     let errors: Vec<SceneError> = super::errors::scene_errors(scene, true)?
