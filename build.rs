@@ -136,17 +136,10 @@ fn cube_tables(scenes: &[scene::Scene<'static>]) -> Result<String, String> {
         if chosen.table == 0 || chosen.fidelity.family() != variant::Family::Cube {
             continue;
         }
-        let built = selection
-            .build(scene)
+        let nodes = table_nodes(scene, &selection)
             .map_err(|error| format!("scene {}: {}: {error}", scene.name, chosen.name))?;
-        let model::AnyModel::CubeTable(table) = built else {
-            return Err(format!(
-                "scene {}: {} did not build a cube table",
-                scene.name, chosen.name
-            ));
-        };
         let _ = write!(out, "    ({:?}, {:?}, &[", scene.name, chosen.name);
-        for (i, node) in table.nodes().iter().enumerate() {
+        for (i, node) in nodes.iter().enumerate() {
             if i % 8 == 0 {
                 out.push_str("\n        ");
             }
@@ -156,6 +149,28 @@ fn cube_tables(scenes: &[scene::Scene<'static>]) -> Result<String, String> {
     }
     out.push_str("];\n");
     Ok(out)
+}
+
+/// The nodes of the cube table `selection` names for `scene`, as `CubeTable::new` builds them.
+#[cfg(feature = "cube")]
+fn table_nodes(
+    scene: &scene::Scene<'_>,
+    selection: &variant::Selection,
+) -> Result<Vec<i32>, String> {
+    match selection.build(scene) {
+        Ok(model::AnyModel::CubeTable(table)) => Ok(table.nodes().to_vec()),
+        Ok(_) => Err("not a cube table".into()),
+        Err(error) => Err(error.to_string()),
+    }
+}
+
+/// Without the cube family no compiled scene has a horn, so none selects a cube table.
+#[cfg(not(feature = "cube"))]
+fn table_nodes(
+    _scene: &scene::Scene<'_>,
+    _selection: &variant::Selection,
+) -> Result<Vec<i32>, String> {
+    Err("the cube family is not in this build".into())
 }
 
 /// A scene description as the firmware's `Scene` type (leaked: the script runs once).
