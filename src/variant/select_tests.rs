@@ -550,3 +550,22 @@ fn a_scene_with_a_measured_twin_uses_its_errors() {
             }
     ));
 }
+
+/// Every built-in scene's choice fits the period on both boards (the G474's 12,500
+/// instructions at 10 kHz included), with the committed step measurements.
+#[test]
+fn every_built_in_scene_fits_the_period_on_both_boards() {
+    for scene in crate::scene::SCENES {
+        for board in [QEMU, G474] {
+            let s = select_for(scene, &table::MEASURED, &board);
+            assert!(
+                !s.refused() && s.period.fits(),
+                "{} on {}: {s}",
+                scene.name,
+                board.name
+            );
+            assert_eq!(s.period.board, board.name);
+            assert!(s.period.step_longest.is_some(), "{}: {s}", scene.name);
+        }
+    }
+}
