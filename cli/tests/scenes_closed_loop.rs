@@ -352,18 +352,35 @@ fn the_model_line_names_the_selected_variant_and_its_reason() {
                 format!("over {points} points"),
             ],
             Reason::NotMeasured { .. } => panic!("{}: built-in scenes are measured", built.name),
+            Reason::Overruns { .. } => panic!("{}: a built-in scene fits its period", built.name),
         };
+        let period = selection.period;
+        assert!(period.fits(), "{line}");
+        assert!(line.contains(&format!("{period}")), "{line}");
         for number in numbers {
             assert!(line.contains(&number), "{number:?} not in {line}");
         }
         let parts = selection.parts.expect(built.name);
         assert!(line.ends_with(&format!("; {parts}")), "{line}");
     }
-    // A scene outside the table: its own model, and the line says it was not measured.
+    // A scene outside the table (another mu: other errors): its own model, and the line says
+    // it was not measured. Another name alone keeps the built-in scene's measurements.
     let horn = find("horn-al-ss").expect("built in");
     let renamed = Scene {
         name: "my-horn",
         ..*horn
+    };
+    let twin = ClosedLoop::new(&renamed).expect("runs");
+    assert_eq!(
+        model_line(twin.station()),
+        model_line(ClosedLoop::new(horn).expect("runs").station())
+    );
+    let renamed = Scene {
+        controller: sonolube::scene::ModelSpec {
+            mu: horn.controller.mu + 0.05,
+            ..horn.controller
+        },
+        ..renamed
     };
     let run = ClosedLoop::new(&renamed).expect("runs");
     let line = model_line(run.station());

@@ -14,10 +14,28 @@ use super::{
 use crate::protocol::Target;
 
 include!(concat!(env!("OUT_DIR"), "/scenes.rs"));
+include!(concat!(env!("OUT_DIR"), "/cube_tables.rs"));
+
+/// Every built-in scene ([`SCENES`]).
+pub fn compiled() -> &'static [Scene<'static>] {
+    SCENES
+}
 
 /// The built-in scene named `name` (the `scene <name>` command), if any.
 pub fn find(name: &str) -> Option<&'static Scene<'static>> {
     SCENES.iter().find(|scene| scene.name == name)
+}
+
+/// The nodes of the cube table `variant` (a variant name, `cube ep T=17x17`) that the build
+/// script computed for `scene` into flash (`build.rs`: the selection's table for every
+/// compiled scene that selects one), if `scene` is that compiled scene in every value (a scene
+/// file loaded at run time under a built-in name but differing from it gets none: its table is
+/// built at scene start, [`crate::model::cube_table::CubeTable::new`]).
+pub fn cube_table_nodes(scene: &Scene<'_>, variant: &str) -> Option<&'static [i32]> {
+    let (_, _, nodes) = CUBE_TABLE_NODES
+        .iter()
+        .find(|(name, table, _)| *name == scene.name && *table == variant)?;
+    (find(scene.name)? == scene).then_some(*nodes)
 }
 
 #[cfg(test)]
@@ -71,6 +89,45 @@ mod tests {
         let reference = find("reference").map(|s| s.transducer.envelope_time_constant_s());
         let tau = reference.unwrap_or(0.0);
         assert!((tau - 0.000_795_8).abs() < 1e-7, "tau = {tau}");
+    }
+
+    /// The cube tables the build script put in flash are, bit for bit, the tables the
+    /// controller built at scene start before (`CubeTable::new` on the selected variant): for
+    /// every compiled scene that selects a table, the model from flash equals the one built
+    /// at run time for a copy of the scene (a copy that differs in its description only, so it
+    /// is not the compiled scene and gets no flash table). A scene that selects no table has
+    /// none in flash.
+    #[test]
+    fn the_cube_tables_in_flash_are_the_runtime_builds() {
+        use crate::variant::fixed::fixed_model;
+        use crate::variant::{Family, select};
+        let mut tables = 0;
+        for scene in SCENES {
+            let Some(variant) = select(scene).variant else {
+                continue;
+            };
+            let nodes = cube_table_nodes(scene, variant.name);
+            if variant.table == 0 || variant.fidelity.family() != Family::Cube {
+                assert!(nodes.is_none(), "{}", scene.name);
+                continue;
+            }
+            let nodes = nodes.unwrap_or_else(|| panic!("{}: no table in flash", scene.name));
+            let side = usize::from(variant.table);
+            assert_eq!(nodes.len(), side * side, "{}", scene.name);
+            let copy = Scene {
+                description: "a copy loaded at run time",
+                ..*scene
+            };
+            assert!(cube_table_nodes(&copy, variant.name).is_none());
+            let from_flash = fixed_model(scene, variant).expect(scene.name);
+            let at_run_time = fixed_model(&copy, variant).expect(scene.name);
+            assert_eq!(from_flash, at_run_time, "{}", scene.name);
+            tables += 1;
+        }
+        // The horn scenes select the 17 x 17 elastic-plastic table (docs/speed.md).
+        let horns = SCENES.iter().filter(|scene| scene.horn.is_some()).count();
+        assert_eq!(tables, horns);
+        assert_eq!(tables >= 3, cfg!(feature = "cube"));
     }
 
     /// A build without a model family (cargo features `dahl`, `cube`, `exp-coulomb`) holds

@@ -176,13 +176,16 @@ pub fn fixed_model(scene: &Scene<'_>, variant: &Variant) -> Result<AnyModel, Mod
                 return Ok(AnyModel::Cube(exact));
             }
             // The table covers the load range the scene states it contains (widened by the
-            // table's margin); loads outside it run `exact`.
+            // table's margin); loads outside it run `exact`. A compiled scene's table is in
+            // flash (the build script built it, `crate::scene::cube_table_nodes`); a scene
+            // loaded at run time builds it here.
             let range = (scene.contents.load_min_n, scene.contents.load_max_n);
-            Ok(AnyModel::CubeTable(CubeTable::new(
-                exact,
-                range,
-                usize::from(variant.table),
-            )?))
+            let side = usize::from(variant.table);
+            let table = match crate::scene::cube_table_nodes(scene, variant.name) {
+                Some(nodes) => CubeTable::with_nodes(exact, range, side, nodes)?,
+                None => CubeTable::new(exact, range, side)?,
+            };
+            Ok(AnyModel::CubeTable(table))
         }
     }
 }

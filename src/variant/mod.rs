@@ -24,6 +24,7 @@
 //! (`host-tests/src/speed`, driven by `scripts/speed-table`); it writes [`table`], the measured
 //! data [`select`] chooses from. [`grid`] holds the operating points both sides use.
 
+pub mod budget;
 pub mod fixed;
 pub mod float_cube;
 pub mod float_inplane;

@@ -36,6 +36,7 @@
 
 use core::fmt;
 
+use super::budget::{BOARD, Board, StepCost};
 use super::fixed::{buildable, fixed_model, variant_buildable};
 use super::{CATALOGUE, Family, Fidelity, Form, Variant, table};
 use crate::model::AnyModel;
@@ -81,6 +82,9 @@ pub struct Measurements {
     pub costs: &'static [Cost],
     /// Errors of the fixed-point model variants per scene and reference level.
     pub errors: &'static [SceneError],
+    /// Whole control steps with each fixed-point model variant, measured in QEMU
+    /// ([`super::budget`]).
+    pub steps: &'static [StepCost],
 }
 
 impl Measurements {
@@ -90,6 +94,14 @@ impl Measurements {
             .iter()
             .find(|c| c.variant == variant)
             .map(|c| c.instructions)
+    }
+
+    /// The longest control step measured with the variant named `variant`, instructions.
+    pub fn longest_step(&self, variant: &str) -> Option<u32> {
+        self.steps
+            .iter()
+            .find(|c| c.variant == variant)
+            .map(|c| c.longest)
     }
 
     /// Error of `variant` against `reference` over `scene`'s grid.
@@ -163,6 +175,41 @@ pub enum Reason {
         /// The scene's controller model.
         kind: ModelKind,
     },
+    /// Refused: no variant that meets the accuracy budget (when none meets it, the most
+    /// accurate; when nothing was measured, the scene's own model at its default knob) has a
+    /// control step within the period budget. The variant named is the one of those whose
+    /// longest step is the shortest. [`Selection::build`] refuses to build it.
+    Overruns {
+        /// Its measured maximum error, % (`None`: the scene's own model, not measured).
+        error_pct: Option<f32>,
+        /// The scene's accuracy budget, %.
+        budget_pct: f32,
+        /// Whether its error meets the accuracy budget.
+        accurate: bool,
+        /// The scene's controller model (for the own-model case).
+        kind: ModelKind,
+    },
+}
+
+/// The control period's budget and the chosen variant's control step ([`super::budget`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Period {
+    /// The board the budget is for ([`super::budget::BOARD`]).
+    pub board: &'static str,
+    /// The scene's control rate, whole Hz.
+    pub rate_hz: u32,
+    /// Instructions in one control period at the scene's rate on that board.
+    pub budget: u32,
+    /// The chosen variant's longest measured control step, instructions (`None`: not
+    /// measured, so not checked).
+    pub step_longest: Option<u32>,
+}
+
+impl Period {
+    /// Whether the step fits (an unmeasured step is not held against the scene).
+    pub fn fits(&self) -> bool {
+        self.step_longest.is_none_or(|step| step <= self.budget)
+    }
 }
 
 /// The model variant a scene runs, and why.
@@ -176,17 +223,38 @@ pub struct Selection {
     pub reason: Reason,
     /// What is modelled and what was skipped (`None` when not measured).
     pub parts: Option<Parts>,
+    /// The period budget and the chosen variant's step.
+    pub period: Period,
 }
 
 /// The variant for `scene` from the committed measurements ([`table::MEASURED`]), which were
-/// taken on the built-in scenes: a scene that differs from the built-in scene of its name in
-/// anything the measurement depends on ([`measured_as_built_in`]) is not measured and keeps
-/// its own model ([`Reason::NotMeasured`]).
+/// taken on the built-in scenes: a scene is measured when a built-in scene with the same
+/// measurement inputs was ([`measured_twin`]: the scene itself, or one that differs only in
+/// what the errors do not depend on, such as its name, control rate or accuracy budget);
+/// otherwise it keeps its own model ([`Reason::NotMeasured`]).
 pub fn select(scene: &Scene<'_>) -> Selection {
-    if !measured_as_built_in(scene) {
-        return not_measured(scene);
+    match measured_twin(scene, &table::MEASURED) {
+        Some(name) => select_from(&Scene { name, ..*scene }, &table::MEASURED),
+        None => not_measured(scene, &table::MEASURED, &BOARD),
     }
-    select_from(scene, &table::MEASURED)
+}
+
+/// The name under which `measured` holds `scene`'s errors: the built-in scene of its name when
+/// [`measured_as_built_in`], else the first built-in scene with the same measurement inputs
+/// (a test scene that is the `reference` scene at another control rate has the `reference`
+/// scene's errors: the grid and the models are the same). `None`: not measured.
+pub fn measured_twin(scene: &Scene<'_>, measured: &Measurements) -> Option<&'static str> {
+    let has_errors = |name: &str| measured.errors.iter().any(|e| e.scene == name);
+    if let Some(built) = crate::scene::find(scene.name)
+        && same_measurement_inputs(scene, built)
+        && has_errors(built.name)
+    {
+        return Some(built.name);
+    }
+    crate::scene::compiled()
+        .iter()
+        .find(|built| same_measurement_inputs(scene, built) && has_errors(built.name))
+        .map(|built| built.name)
 }
 
 /// Whether `scene` is, in everything the committed errors depend on, the built-in scene of its
@@ -196,9 +264,11 @@ pub fn select(scene: &Scene<'_>) -> Selection {
 /// with other contents or parameters, was not measured. The budget (`accuracy`) is not a
 /// measurement input: it is what the selection compares the errors with.
 pub fn measured_as_built_in(scene: &Scene<'_>) -> bool {
-    let Some(built) = crate::scene::find(scene.name) else {
-        return false;
-    };
+    crate::scene::find(scene.name).is_some_and(|built| same_measurement_inputs(scene, built))
+}
+
+/// Whether the committed errors of `built` are `scene`'s too (see [`measured_as_built_in`]).
+fn same_measurement_inputs(scene: &Scene<'_>, built: &Scene<'_>) -> bool {
     let controller = ModelSpec {
         kind: built.controller.kind,
         ..scene.controller
@@ -210,15 +280,52 @@ pub fn measured_as_built_in(scene: &Scene<'_>) -> bool {
         && scene.actuator.full_scale_amplitude_m == built.actuator.full_scale_amplitude_m
 }
 
-/// The scene's own controller model, unmeasured.
-fn not_measured(scene: &Scene<'_>) -> Selection {
+/// A control rate to the nearest whole Hz (the loader keeps it in 1e3 ..= 1e5; `as`
+/// saturates anything else).
+fn whole_hz(rate_hz: f64) -> u32 {
+    libm::round(rate_hz) as u32
+}
+
+/// The fixed-point variant the scene's own controller model is at its default knob
+/// (`AnyModel::new`: Dahl N = 64, cube N = 16), whose control step was measured; `None` for a
+/// model outside the catalogue (`exp-coulomb`).
+pub fn default_variant(kind: ModelKind) -> Option<&'static Variant> {
+    let (fidelity, points) = match kind {
+        ModelKind::Coulomb => (Fidelity::Coulomb, 0),
+        ModelKind::Dahl => (Fidelity::DahlSteady, 64),
+        ModelKind::CubeElastic => (Fidelity::CubeElastic, 16),
+        ModelKind::CubeElasticPlastic => (Fidelity::CubeElasticPlastic, 16),
+        ModelKind::ExpCoulomb => return None,
+    };
+    super::lookup(fidelity, Form::Fixed, points)
+}
+
+/// The scene's own controller model, unmeasured against the reference; refused when its
+/// measured control step does not fit the period.
+fn not_measured(scene: &Scene<'_>, measured: &Measurements, board: &Board) -> Selection {
+    let kind = scene.controller.kind;
+    let period = Period {
+        board: board.name,
+        rate_hz: whole_hz(scene.control_rate_hz),
+        budget: board.period_budget(scene.control_rate_hz),
+        step_longest: default_variant(kind).and_then(|v| measured.longest_step(v.name)),
+    };
+    let reason = if period.fits() {
+        Reason::NotMeasured { kind }
+    } else {
+        Reason::Overruns {
+            error_pct: None,
+            budget_pct: scene.accuracy.model_pct as f32,
+            accurate: false,
+            kind,
+        }
+    };
     Selection {
         variant: None,
         required: None,
-        reason: Reason::NotMeasured {
-            kind: scene.controller.kind,
-        },
+        reason,
         parts: None,
+        period,
     }
 }
 
@@ -260,11 +367,24 @@ struct Candidate {
     variant: &'static Variant,
     instructions: f32,
     error: SceneError,
+    /// Longest control step, instructions.
+    step: u32,
 }
 
-/// [`select`] from the measurements `measured` (tests give their own).
+/// [`select`] from the measurements `measured` (tests give their own), for this build's board
+/// ([`BOARD`]).
 pub fn select_from(scene: &Scene<'_>, measured: &Measurements) -> Selection {
-    let not_measured = not_measured(scene);
+    select_for(scene, measured, &BOARD)
+}
+
+/// [`select_from`] for `board`'s period budget: the cheapest variant that meets the accuracy
+/// budget and whose longest measured control step fits the period; refused
+/// ([`Reason::Overruns`]) when some meet the accuracy and none of those fits, or when none
+/// meets it and the most accurate does not fit either.
+pub fn select_for(scene: &Scene<'_>, measured: &Measurements, board: &Board) -> Selection {
+    let not_measured = not_measured(scene, measured, board);
+    let period_budget = board.period_budget(scene.control_rate_hz);
+    let fits = move |c: &Candidate| c.step <= period_budget;
     let Some((family, required)) = required_fidelity(scene) else {
         return not_measured;
     };
@@ -282,6 +402,7 @@ pub fn select_from(scene: &Scene<'_>, measured: &Measurements) -> Selection {
                     variant: v,
                     instructions: measured.instructions(v.name)?,
                     error: *measured.error(scene.name, v.name, required)?,
+                    step: measured.longest_step(v.name)?,
                 })
             })
     };
@@ -292,11 +413,13 @@ pub fn select_from(scene: &Scene<'_>, measured: &Measurements) -> Selection {
     // more accurate.
     let least = candidates()
         .filter(within)
+        .filter(fits)
         .map(|c| c.instructions)
         .min_by(f32::total_cmp);
     let cheapest = least.and_then(|least| {
         candidates()
             .filter(within)
+            .filter(fits)
             .filter(|c| c.instructions <= least + COST_RESOLUTION)
             .min_by(|a, b| {
                 a.variant
@@ -323,24 +446,45 @@ pub fn select_from(scene: &Scene<'_>, measured: &Measurements) -> Selection {
             },
         ),
         None => {
-            let pick = candidates()
+            let shortest_step = |a: &Candidate, b: &Candidate| a.step.cmp(&b.step);
+            let by_error =
+                |a: &Candidate, b: &Candidate| a.error.max_error.total_cmp(&b.error.max_error);
+            // Accurate enough but too slow: refused, naming the accurate one nearest to fit.
+            let accurate = candidates().filter(within).min_by(shortest_step);
+            // None accurate enough: the most accurate of the required level that fits (else of
+            // any level that fits); refused when nothing fits.
+            let fitting = candidates()
+                .filter(fits)
                 .filter(most_accurate)
-                .min_by(|a, b| a.error.max_error.total_cmp(&b.error.max_error))
-                .or_else(|| {
-                    candidates().min_by(|a, b| a.error.max_error.total_cmp(&b.error.max_error))
-                });
-            let Some(c) = pick else {
-                return not_measured;
+                .min_by(by_error)
+                .or_else(|| candidates().filter(fits).min_by(by_error));
+            let overruns = |c: Candidate| {
+                (
+                    c,
+                    Reason::Overruns {
+                        error_pct: Some(100.0 * c.error.max_error),
+                        budget_pct: budget,
+                        accurate: within(&c),
+                        kind: scene.controller.kind,
+                    },
+                )
             };
-            (
-                c,
-                Reason::NoneMeets {
-                    error_pct: 100.0 * c.error.max_error,
-                    budget_pct: budget,
-                    instructions: c.instructions,
-                    points: c.error.points,
+            match (accurate, fitting) {
+                (Some(c), _) => overruns(c),
+                (None, Some(c)) => (
+                    c,
+                    Reason::NoneMeets {
+                        error_pct: 100.0 * c.error.max_error,
+                        budget_pct: budget,
+                        instructions: c.instructions,
+                        points: c.error.points,
+                    },
+                ),
+                (None, None) => match candidates().min_by(by_error) {
+                    Some(c) => overruns(c),
+                    None => return not_measured,
                 },
-            )
+            }
         }
     };
     let best_of = |level: Fidelity| {
@@ -372,14 +516,33 @@ pub fn select_from(scene: &Scene<'_>, measured: &Measurements) -> Selection {
         required: Some(required),
         reason,
         parts: Some(parts),
+        period: Period {
+            board: board.name,
+            rate_hz: whole_hz(scene.control_rate_hz),
+            budget: period_budget,
+            step_longest: Some(chosen.step),
+        },
     }
 }
 
 impl Selection {
+    /// Whether the scene is refused: no variant fits both the accuracy and the period.
+    pub fn refused(&self) -> bool {
+        matches!(self.reason, Reason::Overruns { .. })
+    }
+
     /// The model the controller should use: the chosen variant built from the scene's
     /// controller parameters and hardware, or the scene's own model when nothing was measured.
     /// Errors: the model's own validation.
+    /// Errors: [`ModelError::OutOfDomain`] on "control period" for a refused selection
+    /// ([`Reason::Overruns`]: its line says which budget fails and by how much).
     pub fn build(&self, scene: &Scene<'_>) -> Result<AnyModel, ModelError> {
+        if self.refused() {
+            return Err(ModelError::OutOfDomain {
+                input: "control period",
+                reason: "no model variant meets the accuracy budget with a control step within the period budget (the selection line says by how much)",
+            });
+        }
         match self.variant {
             Some(variant) => fixed_model(scene, variant),
             None => AnyModel::new(scene, &scene.controller),
@@ -478,17 +641,142 @@ impl fmt::Display for Selection {
                  most accurate, {instructions:.0} instructions, max error {error_pct:.2e} % over \
                  {points} points",
             )?,
-            Reason::NotMeasured { kind } => {
+            Reason::NotMeasured { kind } => write!(
+                f,
+                "model {kind:?} (the scene's own, default knob): not in the measured table"
+            )?,
+            Reason::Overruns {
+                error_pct,
+                budget_pct,
+                accurate,
+                kind,
+            } => {
+                match (self.variant, error_pct) {
+                    (Some(v), Some(e)) => write!(
+                        f,
+                        "REFUSED: model {}, the {} measured against {against} (max error \
+                         {e:.2e} %, budget {budget_pct} %)",
+                        v.name,
+                        if accurate {
+                            "variant within the accuracy budget with the shortest control step"
+                        } else {
+                            "most accurate variant (NONE meets the accuracy budget)"
+                        }
+                    )?,
+                    _ => write!(
+                        f,
+                        "REFUSED: model {kind:?} (the scene's own, default knob, not in the \
+                         measured table)"
+                    )?,
+                }
+                let p = self.period;
+                let step = p.step_longest.unwrap_or(0);
                 return write!(
                     f,
-                    "model {kind:?} (the scene's own, default knob): not in the measured table"
+                    "; period budget {} instructions ({} at {} Hz): its control step, up to {} \
+                     instructions, exceeds it by {} instructions",
+                    Thousands(p.budget),
+                    p.board,
+                    Hz(p.rate_hz),
+                    Thousands(step),
+                    Thousands(step.saturating_sub(p.budget))
                 );
             }
         }
+        self.period.fmt(f)?;
         if let Some(parts) = self.parts {
             write!(f, "; {parts}")?;
         }
         Ok(())
+    }
+}
+
+/// A count with thousands separators (`12,500`).
+struct Thousands(u32);
+
+impl fmt::Display for Thousands {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let n = self.0;
+        if n >= 1_000_000 {
+            write!(
+                f,
+                "{},{:03},{:03}",
+                n / 1_000_000,
+                n / 1000 % 1000,
+                n % 1000
+            )
+        } else if n >= 1000 {
+            write!(f, "{},{:03}", n / 1000, n % 1000)
+        } else {
+            write!(f, "{n}")
+        }
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Thousands {
+    fn format(&self, f: defmt::Formatter) {
+        let n = self.0;
+        if n >= 1_000_000 {
+            defmt::write!(
+                f,
+                "{=u32},{=u32:03},{=u32:03}",
+                n / 1_000_000,
+                n / 1000 % 1000,
+                n % 1000
+            )
+        } else if n >= 1000 {
+            defmt::write!(f, "{=u32},{=u32:03}", n / 1000, n % 1000)
+        } else {
+            defmt::write!(f, "{=u32}", n)
+        }
+    }
+}
+
+/// A control rate in whole hertz (the scene loader keeps it in 1e3 ..= 1e5).
+struct Hz(u32);
+
+impl fmt::Display for Hz {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Hz {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(f, "{=u32}", self.0)
+    }
+}
+
+impl fmt::Display for Period {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "; period budget {} instructions ({}), control step ",
+            Thousands(self.budget),
+            self.board
+        )?;
+        match self.step_longest {
+            Some(step) => write!(f, "up to {} instructions", Thousands(step)),
+            None => f.write_str("not measured"),
+        }
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Period {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "; period budget {} instructions ({=str}), control step ",
+            Thousands(self.budget),
+            self.board
+        );
+        match self.step_longest {
+            Some(step) => defmt::write!(f, "up to {} instructions", Thousands(step)),
+            None => defmt::write!(f, "not measured"),
+        }
     }
 }
 
@@ -530,15 +818,52 @@ impl defmt::Format for Selection {
                 error_pct,
                 points
             ),
-            Reason::NotMeasured { kind } => {
+            Reason::NotMeasured { kind } => defmt::write!(
+                f,
+                "model {} (the scene's own, default knob): not in the measured table",
+                kind
+            ),
+            Reason::Overruns {
+                error_pct,
+                budget_pct,
+                accurate,
+                kind,
+            } => {
+                match (self.variant, error_pct) {
+                    (Some(v), Some(e)) => defmt::write!(
+                        f,
+                        "REFUSED: model {=str}, the {=str} measured against {=str} (max error {=f32} %, budget {=f32} %)",
+                        v.name,
+                        if accurate {
+                            "variant within the accuracy budget with the shortest control step"
+                        } else {
+                            "most accurate variant (NONE meets the accuracy budget)"
+                        },
+                        against,
+                        e,
+                        budget_pct
+                    ),
+                    _ => defmt::write!(
+                        f,
+                        "REFUSED: model {} (the scene's own, default knob, not in the measured table)",
+                        kind
+                    ),
+                }
+                let p = self.period;
+                let step = p.step_longest.unwrap_or(0);
                 defmt::write!(
                     f,
-                    "model {} (the scene's own, default knob): not in the measured table",
-                    kind
+                    "; period budget {} instructions ({=str} at {} Hz): its control step, up to {} instructions, exceeds it by {} instructions",
+                    Thousands(p.budget),
+                    p.board,
+                    Hz(p.rate_hz),
+                    Thousands(step),
+                    Thousands(step.saturating_sub(p.budget))
                 );
                 return;
             }
         }
+        defmt::write!(f, "{}", self.period);
         match self.parts {
             Some(Parts::InPlane { compliance: None }) => defmt::write!(
                 f,

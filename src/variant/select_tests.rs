@@ -4,6 +4,7 @@
 
 use super::*;
 use crate::scene::{ModelSpec, find};
+use crate::variant::budget::{G474, QEMU};
 
 fn leak<T>(items: Vec<T>) -> &'static [T] {
     Box::leak(items.into_boxed_slice())
@@ -34,6 +35,18 @@ fn measured(
                     reference,
                     max_error,
                     points: 120,
+                })
+                .collect(),
+        ),
+        // Every variant's control step well within any period (2,500 instructions at 100 kHz
+        // on the qemu board): the rules under test are the accuracy's.
+        steps: leak(
+            costs
+                .iter()
+                .map(|&(variant, _)| StepCost {
+                    variant,
+                    mean: 900.0,
+                    longest: 1000,
                 })
                 .collect(),
         ),
@@ -312,12 +325,16 @@ fn the_committed_table_applies_only_to_the_scenes_it_measured() {
     use crate::scene::{Accuracy, Contents, Transducer};
     let horn = find("horn-al-ss").unwrap();
     assert!(measured_as_built_in(horn));
+    // Another name only: not the built-in scene, but measured with its errors (its twin).
+    let copy = Scene {
+        name: "horn-copy",
+        ..*horn
+    };
+    assert!(!measured_as_built_in(&copy));
+    assert_eq!(measured_twin(&copy, &table::MEASURED), Some("horn-al-ss"));
+    assert_eq!(select(&copy).variant, select(horn).variant);
     // Anything the errors were measured with, changed: not measured, the scene's own model.
     let other = [
-        Scene {
-            name: "horn-copy",
-            ..*horn
-        },
         Scene {
             contents: Contents {
                 load_min_n: horn.contents.load_min_n + 20.0,
@@ -360,7 +377,7 @@ fn the_committed_table_applies_only_to_the_scenes_it_measured() {
     let base = select(horn);
     let cost = |s: &Selection| match s.reason {
         Reason::Meets { instructions, .. } | Reason::NoneMeets { instructions, .. } => instructions,
-        Reason::NotMeasured { .. } => f32::INFINITY,
+        Reason::NotMeasured { .. } | Reason::Overruns { .. } => f32::INFINITY,
     };
     let same = [
         Scene {
@@ -387,5 +404,168 @@ fn the_committed_table_applies_only_to_the_scenes_it_measured() {
         let s = select(scene);
         assert!(s.variant.is_some(), "{s}");
         assert!(cost(&s) <= cost(&base), "{s} vs {base}");
+    }
+}
+
+/// Measurements whose steps are `steps` (variant, longest step) instead.
+fn with_steps(m: Measurements, steps: &[(&'static str, u32)]) -> Measurements {
+    Measurements {
+        steps: leak(
+            steps
+                .iter()
+                .map(|&(variant, longest)| StepCost {
+                    variant,
+                    mean: longest as f32,
+                    longest,
+                })
+                .collect(),
+        ),
+        ..m
+    }
+}
+
+/// The period: the cheapest accurate variant whose longest step fits wins; accurate ones that
+/// all overrun refuse the scene, naming the budget and the excess; the same scene fits the
+/// qemu board's 25,000 instructions at 10 kHz and not the G474's 12,500.
+#[test]
+fn the_choice_fits_the_control_period_or_the_scene_is_refused() {
+    let scene = *find("load-ramp").unwrap();
+    let base = measured(
+        &cube_costs(),
+        &[
+            ("load-ramp", "cube el N=4", EP, 0.02),
+            ("load-ramp", "cube el N=8", EP, 0.02),
+            ("load-ramp", "cube ep N=4", EP, 0.004),
+            ("load-ramp", "cube ep N=8", EP, 0.001),
+            ("load-ramp", "cube ep N=16", EP, 0.0001),
+        ],
+    );
+    let steps = [
+        ("cube el N=4", 900),
+        ("cube el N=8", 1_200),
+        ("cube ep N=4", 30_000),
+        ("cube ep N=8", 14_000),
+        ("cube ep N=16", 20_000),
+    ];
+    let m = with_steps(base, &steps);
+    // Budget 0.5 %: ep N=4 is the cheapest accurate one but overruns 25,000; N=8 fits.
+    let s = select_for(&scene, &m, &QEMU);
+    assert_eq!(s.variant.map(|v| v.name), Some("cube ep N=8"), "{s}");
+    assert!(!s.refused());
+    assert_eq!(s.period.budget, 25_000);
+    assert_eq!(s.period.step_longest, Some(14_000));
+    assert!(
+        std::format!("{s}").contains("period budget 25,000 instructions (qemu)"),
+        "{s}"
+    );
+    // On the G474 (12,500 at 10 kHz) no accurate variant fits: refused, by 1,500.
+    let g = select_for(&scene, &m, &G474);
+    assert!(g.refused(), "{g}");
+    assert!(matches!(g.reason, Reason::Overruns { accurate: true, .. }));
+    assert_eq!(g.variant.map(|v| v.name), Some("cube ep N=8"));
+    let line = std::format!("{g}");
+    assert!(line.contains("REFUSED"), "{line}");
+    assert!(
+        line.contains("period budget 12,500 instructions (nucleo-g474re at 10000 Hz)"),
+        "{line}"
+    );
+    assert!(line.contains("exceeds it by 1,500 instructions"), "{line}");
+    assert!(g.build(&scene).is_err());
+    // Ten times the rate: 2,500 on qemu; nothing accurate fits.
+    let fast = Scene {
+        control_rate_hz: 100_000.0,
+        ..scene
+    };
+    let f = select_for(&fast, &m, &QEMU);
+    assert!(f.refused() && f.period.budget == 2_500, "{f}");
+    // A variant without a measured step is no candidate.
+    let partial = with_steps(base, &steps[..2]);
+    let p = select_for(&scene, &partial, &QEMU);
+    assert!(
+        p.variant.is_none_or(|v| v.name.starts_with("cube el")),
+        "{p}"
+    );
+}
+
+/// A scene nothing was measured for runs its own model at the default knob only when that
+/// model's measured step fits.
+#[test]
+fn an_unmeasured_scene_is_refused_when_its_own_model_overruns() {
+    let reference = *find("reference").unwrap();
+    let mine = Scene {
+        name: "not-built-in",
+        controller: ModelSpec {
+            kind: ModelKind::Dahl,
+            ..reference.controller
+        },
+        ..reference
+    };
+    let m = with_steps(
+        measured(&[], &[]),
+        &[("Dahl steady N=64", 891_440), ("Coulomb ratio", 3_400)],
+    );
+    let s = not_measured(&mine, &m, &QEMU);
+    assert!(s.refused(), "{s}");
+    assert!(
+        std::format!("{s}").contains("exceeds it by 866,440 instructions"),
+        "{s}"
+    );
+    let coulomb = Scene {
+        controller: reference.controller,
+        ..mine
+    };
+    let c = not_measured(&coulomb, &m, &QEMU);
+    assert!(matches!(c.reason, Reason::NotMeasured { .. }), "{c}");
+    assert!(c.period.fits());
+}
+
+/// A scene that differs from a measured built-in scene only in what the errors do not depend
+/// on (name, control rate) is measured with that scene's errors; one with another k_t is not.
+#[test]
+fn a_scene_with_a_measured_twin_uses_its_errors() {
+    let reference = *find("reference").unwrap();
+    let fast = Scene {
+        name: "ref-100khz",
+        control_rate_hz: 100_000.0,
+        ..reference
+    };
+    assert_eq!(measured_twin(&fast, &table::MEASURED), Some("reference"));
+    let s = select(&fast);
+    assert_eq!(s.variant, select(&reference).variant);
+    assert_eq!(s.period.budget, 2_500);
+    let stiffer = Scene {
+        controller: ModelSpec {
+            k_t_n_per_m: reference.controller.k_t_n_per_m.map(|k| 2.0 * k),
+            ..reference.controller
+        },
+        ..fast
+    };
+    assert_eq!(measured_twin(&stiffer, &table::MEASURED), None);
+    assert!(matches!(
+        select(&stiffer).reason,
+        Reason::NotMeasured { .. }
+            | Reason::Overruns {
+                error_pct: None,
+                ..
+            }
+    ));
+}
+
+/// Every built-in scene's choice fits the period on both boards (the G474's 12,500
+/// instructions at 10 kHz included), with the committed step measurements.
+#[test]
+fn every_built_in_scene_fits_the_period_on_both_boards() {
+    for scene in crate::scene::SCENES {
+        for board in [QEMU, G474] {
+            let s = select_for(scene, &table::MEASURED, &board);
+            assert!(
+                !s.refused() && s.period.fits(),
+                "{} on {}: {s}",
+                scene.name,
+                board.name
+            );
+            assert_eq!(s.period.board, board.name);
+            assert!(s.period.step_longest.is_some(), "{}: {s}", scene.name);
+        }
     }
 }

@@ -5,35 +5,37 @@
 //! reference; do not edit. Method and the full table: `docs/speed.md`.
 
 use super::Fidelity;
+use super::budget::StepCost;
 use super::select::{Cost, Measurements, SceneError};
 
 /// The measurements [`super::select`] chooses from.
 pub static MEASURED: Measurements = Measurements {
     costs: COSTS,
     errors: ERRORS,
+    steps: STEPS,
 };
 
 /// Instructions per evaluation on the Cortex-M4 (QEMU, `-icount shift=0`).
 static COSTS: &[Cost] = &[
     Cost {
         variant: "Littmann closed form",
-        instructions: 42.182,
+        instructions: 45.169,
     },
     Cost {
         variant: "Littmann closed form f32 micromath",
-        instructions: 30.885,
+        instructions: 33.872,
     },
     Cost {
         variant: "Littmann closed form f32 libm",
-        instructions: 414.858,
+        instructions: 417.807,
     },
     Cost {
         variant: "Littmann closed form f64",
-        instructions: 3355.998,
+        instructions: 3356.093,
     },
     Cost {
         variant: "Dahl update",
-        instructions: 43.863,
+        instructions: 43.829,
     },
     Cost {
         variant: "Dahl update f32 micromath",
@@ -41,59 +43,59 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl update f32 libm",
-        instructions: 60.205,
+        instructions: 60.239,
     },
     Cost {
         variant: "Dahl update f64",
-        instructions: 2228.068,
+        instructions: 2228.136,
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 315.196,
+        instructions: 315.343,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 68.872,
+        instructions: 68.725,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 259.166,
+        instructions: 259.068,
     },
     Cost {
         variant: "Coulomb ratio f64",
-        instructions: 2720.049,
+        instructions: 2720.0,
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11353.279,
+        instructions: 11353.333,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 5869.731,
+        instructions: 5869.462,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 31789.838,
+        instructions: 31789.783,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 147230.22,
+        instructions: 147229.84,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20281.182,
+        instructions: 20280.967,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
-        instructions: 11294.838,
+        instructions: 11294.784,
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 58561.29,
+        instructions: 58561.184,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 269833.94,
+        instructions: 269833.72,
     },
     Cost {
         variant: "Dahl steady N=64",
@@ -101,27 +103,27 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22175.912,
+        instructions: 22176.021,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 111755.86,
+        instructions: 111755.914,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 511146.56,
+        instructions: 511146.5,
     },
     Cost {
         variant: "Dahl steady T=33x33",
-        instructions: 910.698,
+        instructions: 910.483,
     },
     Cost {
         variant: "Dahl steady T=65x65",
-        instructions: 912.043,
+        instructions: 912.096,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 591.818,
+        instructions: 591.969,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
@@ -129,43 +131,43 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 260.454,
+        instructions: 260.151,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9423.484,
+        instructions: 9423.787,
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 830.0,
+        instructions: 830.151,
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 631.969,
+        instructions: 631.818,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
-        instructions: 388.333,
+        instructions: 388.787,
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15229.09,
+        instructions: 15228.787,
     },
     Cost {
         variant: "cube el N=16",
-        instructions: 1306.06,
+        instructions: 1305.909,
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
-        instructions: 1141.969,
+        instructions: 1141.666,
     },
     Cost {
         variant: "cube el N=16 f32 libm",
-        instructions: 647.272,
+        instructions: 646.969,
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26879.848,
+        instructions: 26879.393,
     },
     Cost {
         variant: "cube el N=32",
@@ -173,15 +175,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.363,
+        instructions: 2161.666,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
-        instructions: 1162.878,
+        instructions: 1163.181,
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50123.18,
+        instructions: 50123.484,
     },
     Cost {
         variant: "cube el T=5x5",
@@ -189,19 +191,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el T=9x9",
-        instructions: 282.727,
+        instructions: 282.878,
     },
     Cost {
         variant: "cube el T=17x17",
-        instructions: 282.727,
+        instructions: 282.575,
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 592.121,
+        instructions: 591.666,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 378.181,
+        instructions: 377.727,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
@@ -209,7 +211,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9414.696,
+        instructions: 9414.393,
     },
     Cost {
         variant: "cube ep N=8",
@@ -217,7 +219,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 632.121,
+        instructions: 631.818,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
@@ -225,51 +227,51 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=8 f64",
-        instructions: 15216.212,
+        instructions: 15216.363,
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1305.757,
+        instructions: 1306.06,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
-        instructions: 1141.666,
+        instructions: 1141.818,
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 646.969,
+        instructions: 647.272,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26868.182,
+        instructions: 26867.879,
     },
     Cost {
         variant: "cube ep N=32",
-        instructions: 2257.727,
+        instructions: 2257.878,
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
-        instructions: 2161.666,
+        instructions: 2161.515,
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
-        instructions: 1162.878,
+        instructions: 1163.03,
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50111.06,
+        instructions: 50111.21,
     },
     Cost {
         variant: "cube ep T=5x5",
-        instructions: 282.878,
+        instructions: 282.727,
     },
     Cost {
         variant: "cube ep T=9x9",
-        instructions: 283.03,
+        instructions: 282.878,
     },
     Cost {
         variant: "cube ep T=17x17",
-        instructions: 282.727,
+        instructions: 282.878,
     },
 ];
 
@@ -1164,5 +1166,109 @@ static ERRORS: &[SceneError] = &[
         reference: Fidelity::DahlSteady,
         max_error: 1.29e-5,
         points: 120,
+    },
+];
+
+/// Whole control steps with each fixed-point model variant (QEMU, `-icount shift=0`).
+static STEPS: &[StepCost] = &[
+    StepCost {
+        variant: "Coulomb ratio",
+        mean: 3181.28,
+        longest: 3480,
+    },
+    StepCost {
+        variant: "Dahl steady N=16",
+        mean: 210205.28,
+        longest: 262120,
+    },
+    StepCost {
+        variant: "Dahl steady N=32",
+        mean: 380271.03,
+        longest: 473880,
+    },
+    StepCost {
+        variant: "Dahl steady N=64",
+        mean: 715220.6,
+        longest: 891280,
+    },
+    StepCost {
+        variant: "Dahl steady T=33x33",
+        mean: 5453.6,
+        longest: 6320,
+    },
+    StepCost {
+        variant: "Dahl steady T=65x65",
+        mean: 5593.12,
+        longest: 6480,
+    },
+    StepCost {
+        variant: "cube el N=4",
+        mean: 4627.534,
+        longest: 6200,
+    },
+    StepCost {
+        variant: "cube el N=8",
+        mean: 5616.461,
+        longest: 7680,
+    },
+    StepCost {
+        variant: "cube el N=16",
+        mean: 7592.712,
+        longest: 10720,
+    },
+    StepCost {
+        variant: "cube el N=32",
+        mean: 11551.843,
+        longest: 16800,
+    },
+    StepCost {
+        variant: "cube el T=5x5",
+        mean: 3657.341,
+        longest: 3760,
+    },
+    StepCost {
+        variant: "cube el T=9x9",
+        mean: 3684.08,
+        longest: 3840,
+    },
+    StepCost {
+        variant: "cube el T=17x17",
+        mean: 3694.087,
+        longest: 3880,
+    },
+    StepCost {
+        variant: "cube ep N=4",
+        mean: 4629.269,
+        longest: 6160,
+    },
+    StepCost {
+        variant: "cube ep N=8",
+        mean: 5617.261,
+        longest: 7760,
+    },
+    StepCost {
+        variant: "cube ep N=16",
+        mean: 7596.84,
+        longest: 10760,
+    },
+    StepCost {
+        variant: "cube ep N=32",
+        mean: 11551.429,
+        longest: 16840,
+    },
+    StepCost {
+        variant: "cube ep T=5x5",
+        mean: 3657.643,
+        longest: 3800,
+    },
+    StepCost {
+        variant: "cube ep T=9x9",
+        mean: 3685.312,
+        longest: 3840,
+    },
+    StepCost {
+        variant: "cube ep T=17x17",
+        mean: 3694.981,
+        longest: 3840,
     },
 ];

@@ -42,6 +42,7 @@ use sonolube::model::AnyModel;
 use sonolube::model::cube_table::CubeTable;
 use sonolube::model::{FrictionModel, OperatingPoint, dahl, littmann};
 use sonolube::scene::{ModelKind, ModelSpec, SCENES, Scene};
+use sonolube::variant::budget::step_scene;
 use sonolube::variant::fixed::fixed_model;
 use sonolube::variant::float_inplane::{dahl_update, littmann as float_littmann};
 use sonolube::variant::grid::{
@@ -474,5 +475,72 @@ pub fn run() -> bool {
     for &(name, scene, fidelity, table) in CONTROL_STEPS {
         ok &= control_step(name, scene, fidelity, table, shift);
     }
+    ok &= variant_steps(shift);
     ok
+}
+
+/// The control step with every fixed-point model variant, for the period budget
+/// (`sonolube::variant::budget`): `bench step NAME: ...`, the variant set as the controller's
+/// model of its step scene ([`step_scene`]), timed as [`control_step`] times a level.
+fn variant_steps(shift: u32) -> bool {
+    let mut ok = true;
+    for variant in CATALOGUE {
+        let Some(scene_name) = step_scene(variant) else {
+            continue;
+        };
+        watchdog::feed();
+        ok &= variant_step(variant, scene_name, shift);
+    }
+    ok
+}
+
+/// Times the control phase of `scene_name` run with `variant` as its controller model.
+fn variant_step(variant: &Variant, scene_name: &str, shift: u32) -> bool {
+    let Some(scene) = sonolube::scene::find(scene_name) else {
+        defmt::error!(
+            "bench step {=str}: no scene {=str}",
+            variant.name,
+            scene_name
+        );
+        return false;
+    };
+    let run = fixed_model(scene, variant)
+        .map_err(SimError::Model)
+        .and_then(|model| ClosedLoop::with_model(scene, model));
+    let mut closed_loop = match run {
+        Ok(run) => run,
+        Err(error) => {
+            defmt::error!("bench step {=str}: {}", variant.name, error);
+            return false;
+        }
+    };
+    let (mut tally, mut longest) = (Tally::default(), 0u64);
+    while !closed_loop.is_finished() {
+        if closed_loop.plant_phase().is_none() {
+            break;
+        }
+        watchdog::feed();
+        let start = time_driver::cycles();
+        let control = closed_loop.control_phase();
+        let cycles = time_driver::cycles().saturating_sub(start);
+        if control.is_none() || closed_loop.finish_step().is_none() {
+            break;
+        }
+        tally.cycles += cycles as i64;
+        tally.calls += 1;
+        longest = longest.max(cycles);
+    }
+    let Some(milli) = milli_instructions(tally.cycles, tally.calls, shift) else {
+        defmt::error!("bench step {=str}: no steps", variant.name);
+        return false;
+    };
+    defmt::info!(
+        "bench step {=str}: {=u64}.{=u64:03} instructions per call ({=u64} calls, longest {=u64})",
+        variant.name,
+        milli / 1000,
+        milli % 1000,
+        tally.calls,
+        (longest * NS_PER_CYCLE) >> shift
+    );
+    true
 }

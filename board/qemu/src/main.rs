@@ -165,6 +165,12 @@ async fn supervisor_task(args: Args, control_spawner: SendSpawner) {
     let rig = match time_driver::exclude(|| SimulatedRig::new(scene, mode)) {
         Ok(rig) => rig.with_home(home),
         Err(error) => {
+            // A scene refused for its control period: the selection line says which budget
+            // fails and by how much (`sonolube::variant::select`).
+            let selection = sonolube::variant::select(scene);
+            if selection.refused() {
+                defmt::error!("scene {=str}: controller {}", scene.name, selection);
+            }
             defmt::error!("scene {=str} cannot run: {}", scene.name, error);
             exit::exit(exit::SELFCHECK_FAILED);
         }

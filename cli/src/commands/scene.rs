@@ -409,11 +409,17 @@ pub fn run_with(
                 .map_err(|e| format!("{}: {e}", variant.name))?;
             ClosedLoop::with_model(scene, model)
         }
-        None => ClosedLoop::with_selection(
-            scene,
-            crate::speed::table_rs::select_on_host(scene)
-                .map_err(|error| why::cannot_select(scene, &error))?,
-        ),
+        None => {
+            let selection = crate::speed::table_rs::select_on_host(scene)
+                .map_err(|error| why::cannot_select(scene, &error))?;
+            if selection.refused() {
+                return Err(format!(
+                    "scene {} refused at load: controller {selection}",
+                    scene.name
+                ));
+            }
+            ClosedLoop::with_selection(scene, selection)
+        }
     };
     let mut sim = built.map_err(|e| why::cannot_run(scene, &e))?;
     // What cannot work is refused before the run, with the number that fails (issue 26).

@@ -10,7 +10,7 @@ use sonolube::variant::{CATALOGUE, CONTROL_STEPS, Family, Fidelity, find, grid};
 
 use super::errors::{Errors, Stats};
 use super::fronts::{Set, Standing, is_kernel, standing};
-use super::qemu::{Counts, build_name, inverse_name};
+use super::qemu::{Counts, build_name, inverse_name, step_name};
 use super::table_rs::COMMAND;
 use super::timing::{SAMPLE_TIME, SAMPLES};
 
@@ -174,6 +174,48 @@ impl Report<'_> {
                 thousands(nodes as f64),
                 thousands(MAX_NODES as f64),
                 thousands(4.0 * MAX_NODES as f64),
+            );
+        }
+    }
+
+    /// The control step with each fixed-point variant against the 10 kHz period budgets.
+    fn period_budget(&self, s: &mut String) {
+        use sonolube::variant::budget::{G474, QEMU, step_scene};
+        let (qemu, g474) = (QEMU.period_budget(10e3), G474.period_budget(10e3));
+        let _ = writeln!(
+            s,
+            "| variant | scene | steps | mean | longest | fits qemu at 10 kHz ({}) | fits G474 at 10 kHz ({}) | highest rate that fits, qemu / G474 |\n|---|---|---:|---:|---:|---|---|---:|",
+            thousands(f64::from(qemu)),
+            thousands(f64::from(g474))
+        );
+        for v in CATALOGUE {
+            let (Some(scene), Some(c)) = (step_scene(v), self.counts.get(&step_name(v.name)))
+            else {
+                continue;
+            };
+            let longest = c.longest.unwrap_or(0);
+            let fits = |budget: u32| {
+                if longest <= u64::from(budget) {
+                    "yes".to_string()
+                } else {
+                    format!("no, by {}", thousands((longest - u64::from(budget)) as f64))
+                }
+            };
+            let rate = |ips: u64| {
+                ips.checked_div(longest)
+                    .map_or("-".to_string(), |hz| format!("{} Hz", thousands(hz as f64)))
+            };
+            let _ = writeln!(
+                s,
+                "| {} | `{scene}` | {} | {} | {} | {} | {} | {} / {} |",
+                v.name,
+                thousands(c.calls as f64),
+                thousands(c.instructions),
+                thousands(longest as f64),
+                fits(qemu),
+                fits(g474),
+                rate(QEMU.instructions_per_s),
+                rate(G474.instructions_per_s)
             );
         }
     }
@@ -447,15 +489,35 @@ impl Report<'_> {
             s,
             "## Table builds\n\n\
              A table variant (`T=SxS`) evaluates F'/F by bilinear interpolation in a table of \
-             S x S nodes over (ln load, amplitude) that the controller builds at scene start \
-             from its exact fixed-point model (N = 16, so host and firmware tables are \
-             bit-identical; `sonolube::model::cube_table`). Its per-evaluation cost does not \
+             S x S nodes over (ln load, amplitude), built from its exact fixed-point model \
+             (N = 16; `sonolube::model::cube_table`). For a compiled scene the build script \
+             builds the table its selection picks into flash with the crate's own code (so \
+             it is bit-identical to a build at scene start, which a test checks), and scene \
+             start copies it; a scene file loaded at run time (the host's `--file`) builds it \
+             at scene start, at the cost below. Its per-evaluation cost does not \
              grow with S; the build does, and so does the accuracy. The storage is fixed: every \
              table reserves the largest (17 x 17), since a controller holds its model by value \
              in `AnyModel`. Builds counted in QEMU as above, once per cube scene, the copy of \
              the exact model included:\n"
         );
         self.table_builds(&mut s);
+        s.push('\n');
+        let _ = writeln!(
+            s,
+            "## The control period's budget\n\n\
+             The selection picks the cheapest variant that meets a scene's accuracy budget and \
+             whose **longest** control step fits the period: the board's instructions per second \
+             over the scene's control rate (`sonolube::variant::budget`: the `qemu` board at \
+             `-icount shift=2`, 250 M instructions/s, 10 instructions per 25 MHz cycle; the \
+             G474 at 170 MHz and a stated 0.735 instructions per cycle, 125 M instructions/s). \
+             When no accurate variant fits, the scene is refused: at load on the host \
+             (`sonolube scene`), at scene start on the boards, the selection line saying which \
+             budget fails and by how much. The whole control step \
+             (`ClosedLoop::control_phase`) with each fixed-point variant, counted in QEMU as \
+             above over every step of the named scene (`bench step NAME`), against the budget \
+             at 10 kHz:\n"
+        );
+        self.period_budget(&mut s);
         s.push('\n');
         let _ = writeln!(
             s,

@@ -8,6 +8,7 @@
 
 use std::collections::BTreeMap;
 
+use sonolube::variant::budget::step_scene;
 use sonolube::variant::{CATALOGUE, CONTROL_STEPS};
 
 /// One measurement.
@@ -80,6 +81,21 @@ pub fn table_count_name(variant: &sonolube::variant::Variant) -> String {
     }
 }
 
+/// The name of a fixed-point model variant's control-step count (`bench step NAME`, the
+/// period budget's, `sonolube::variant::budget`).
+pub fn step_name(variant: &str) -> String {
+    format!("step {variant}")
+}
+
+/// Names of every control-step count of the variants (one per fixed-point model variant).
+pub fn step_names() -> Vec<String> {
+    CATALOGUE
+        .iter()
+        .filter(|v| step_scene(v).is_some())
+        .map(|v| step_name(v.name))
+        .collect()
+}
+
 /// The name of a Dahl table variant's inverse count (`bench inverse NAME`).
 pub fn inverse_name(variant: &str) -> String {
     format!("inverse {variant}")
@@ -107,11 +123,13 @@ pub fn parse(log: &str) -> Result<Counts, String> {
         .filter(|v| v.table > 0)
         .map(table_count_name)
         .collect();
+    let steps = step_names();
     let expected = CATALOGUE
         .iter()
         .map(|v| v.name)
         .chain(CONTROL_STEPS.iter().map(|c| c.0))
-        .chain(builds.iter().map(String::as_str));
+        .chain(builds.iter().map(String::as_str))
+        .chain(steps.iter().map(String::as_str));
     let missing: Vec<&str> = expected.filter(|n| !counts.contains_key(*n)).collect();
     if !missing.is_empty() {
         return Err(format!(
@@ -146,6 +164,11 @@ mod tests {
                 "1.0 INFO  bench {name}: 2764.320 instructions per call (250 calls, longest 3040)\n"
             ));
         }
+        for name in step_names() {
+            log.push_str(&format!(
+                "1.1 INFO  bench {name}: 2764.320 instructions per call (250 calls, longest 3040)\n"
+            ));
+        }
         log
     }
 
@@ -154,7 +177,10 @@ mod tests {
         let counts = parse(&full_log()).unwrap();
         let tables = CATALOGUE.iter().filter(|v| v.table > 0).count();
         assert!(tables > 0);
-        assert_eq!(counts.len(), CATALOGUE.len() + CONTROL_STEPS.len() + tables);
+        assert_eq!(
+            counts.len(),
+            CATALOGUE.len() + CONTROL_STEPS.len() + tables + step_names().len()
+        );
         assert_eq!(counts["build cube ep T=17x17"].calls, 3);
         let no_build = full_log().replace("bench build cube ep T=9x9:", "bench other:");
         assert!(

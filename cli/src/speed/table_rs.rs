@@ -6,6 +6,7 @@
 
 use std::fmt::Write as _;
 
+use sonolube::variant::budget::StepCost;
 use sonolube::variant::select::{Cost, Measurements, SceneError};
 use sonolube::variant::{CATALOGUE, Form};
 
@@ -27,6 +28,21 @@ fn costs(counts: &Counts) -> Vec<Cost> {
         .collect()
 }
 
+/// The control step with each fixed-point model variant (`bench step NAME`).
+fn steps(counts: &Counts) -> Vec<StepCost> {
+    CATALOGUE
+        .iter()
+        .filter_map(|v| {
+            let count = counts.get(&super::qemu::step_name(v.name))?;
+            Some(StepCost {
+                variant: v.name,
+                mean: count.instructions as f32,
+                longest: count.longest.unwrap_or(0).min(u64::from(u32::MAX)) as u32,
+            })
+        })
+        .collect()
+}
+
 fn scene_errors(errors: &Errors) -> Vec<SceneError> {
     errors
         .scenes
@@ -43,15 +59,16 @@ fn scene_errors(errors: &Errors) -> Vec<SceneError> {
 }
 
 /// The selection for `scene` as the host makes it when it loads the scene: the firmware's
-/// ([`sonolube::variant::select`], from the committed table) for a built-in scene as measured,
+/// ([`sonolube::variant::select`], from the committed table) for a scene whose measurement
+/// inputs a built-in scene's errors were measured with ([`measured_twin`]),
 /// and otherwise from the errors of the fixed-point candidates measured now against the
 /// reference for this scene's contents ([`super::errors::scene_errors`], a few seconds at
 /// most) with the committed instruction counts. Errors: the reference's (message).
 pub fn select_on_host(
     scene: &sonolube::scene::Scene<'_>,
 ) -> Result<sonolube::variant::Selection, String> {
-    use sonolube::variant::select::{measured_as_built_in, select_from};
-    if measured_as_built_in(scene) {
+    use sonolube::variant::select::{measured_twin, select_from};
+    if measured_twin(scene, &sonolube::variant::table::MEASURED).is_some() {
         return Ok(sonolube::variant::select(scene));
     }
     let errors: Vec<SceneError> = super::errors::scene_errors(scene, true)?
@@ -67,6 +84,7 @@ pub fn select_on_host(
     let measured = Measurements {
         costs: sonolube::variant::table::MEASURED.costs,
         errors: Box::leak(errors.into_boxed_slice()),
+        steps: sonolube::variant::table::MEASURED.steps,
     };
     Ok(select_from(scene, &measured))
 }
@@ -76,6 +94,7 @@ pub fn measurements(errors: &Errors, counts: &Counts) -> Measurements {
     Measurements {
         costs: Box::leak(costs(counts).into_boxed_slice()),
         errors: Box::leak(scene_errors(errors).into_boxed_slice()),
+        steps: Box::leak(steps(counts).into_boxed_slice()),
     }
 }
 
@@ -125,10 +144,11 @@ pub fn render(errors: &Errors, counts: &Counts) -> String {
          //! reference; do not edit. Method and the full table: `docs/speed.md`.\n\
          \n\
          use super::Fidelity;\n\
+         use super::budget::StepCost;\n\
          use super::select::{{Cost, Measurements, SceneError}};\n\
          \n\
          /// The measurements [`super::select`] chooses from.\n\
-         pub static MEASURED: Measurements = Measurements {{\n    costs: COSTS,\n    errors: ERRORS,\n}};\n\
+         pub static MEASURED: Measurements = Measurements {{\n    costs: COSTS,\n    errors: ERRORS,\n    steps: STEPS,\n}};\n\
          \n\
          /// Instructions per evaluation on the Cortex-M4 (QEMU, `-icount shift=0`).\n\
          static COSTS: &[Cost] = &["
@@ -156,6 +176,19 @@ pub fn render(errors: &Errors, counts: &Counts) -> String {
             e.reference,
             literal(e.max_error),
             e.points
+        );
+    }
+    s.push_str(
+        "];\n\n/// Whole control steps with each fixed-point model variant (QEMU, `-icount shift=0`).\n\
+         static STEPS: &[StepCost] = &[\n",
+    );
+    for c in steps(counts) {
+        let _ = writeln!(
+            s,
+            "    StepCost {{\n        variant: {:?},\n        mean: {},\n        longest: {},\n    }},",
+            c.variant,
+            literal(c.mean),
+            c.longest
         );
     }
     s.push_str("];\n");

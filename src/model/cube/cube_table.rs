@@ -108,6 +108,54 @@ impl CubeTable {
         load_range_n: (f64, f64),
         side: usize,
     ) -> Result<Self, ModelError> {
+        let mut table = Self::layout(exact, load_range_n, side)?;
+        for row in 0..side {
+            let ln = Q6_26::from_bits(table.ln_load_low + row as i32 * table.ln_load_step);
+            let point = table.exact.scene().prepare(ln)?;
+            for column in 0..side {
+                let ratio = table
+                    .exact
+                    .ratio_prepared(&point, table.node_amplitude(column))?;
+                table.nodes[row * side + column] = ratio.to_bits();
+            }
+        }
+        table.check_rows()?;
+        Ok(table)
+    }
+
+    /// The table [`Self::new`] builds, with the nodes it computed given instead (`side`^2 Q2.30
+    /// bits, row-major, as [`Self::nodes`] returns them): the build script computes them once
+    /// per compiled scene into flash (`build.rs`, `crate::scene::builtin::cube_table_nodes`),
+    /// and scene start copies them (about 300 instructions instead of 316,120 for 17 x 17).
+    /// Errors: those of [`Self::new`] but the nodes' evaluation, and a node count that is not
+    /// `side`^2.
+    pub fn with_nodes(
+        exact: CubeModel,
+        load_range_n: (f64, f64),
+        side: usize,
+        nodes: &[i32],
+    ) -> Result<Self, ModelError> {
+        let mut table = Self::layout(exact, load_range_n, side)?;
+        let count = side * side;
+        if nodes.len() != count {
+            return Err(ModelError::OutOfDomain {
+                input: "table nodes",
+                reason: "a table of side S holds S x S nodes",
+            });
+        }
+        table.nodes[..count].copy_from_slice(nodes);
+        table.check_rows()?;
+        Ok(table)
+    }
+
+    /// The nodes in use, Q2.30 bits, row-major (`side`^2 of them).
+    pub fn nodes(&self) -> &[i32] {
+        &self.nodes[..self.side() * self.side()]
+    }
+
+    /// The table of `side` nodes per axis over `load_range_n` with every node 0: the checks and
+    /// the load axis of [`Self::new`].
+    fn layout(exact: CubeModel, load_range_n: (f64, f64), side: usize) -> Result<Self, ModelError> {
         if !(3..=MAX_SIDE).contains(&side) || !(side - 1).is_power_of_two() {
             return Err(ModelError::OutOfDomain {
                 input: "table side",
@@ -143,7 +191,7 @@ impl CubeTable {
         let ln_load_step = i32::try_from(step).map_err(|_| out_of_range())?; // > 0: span >= 1/4
         let bits = 32 - (step as u32).leading_zeros();
         let reciprocal = ((1u64 << (30 + bits)) + step as u64 / 2) / step as u64; // <= 2^31
-        let mut table = Self {
+        Ok(Self {
             exact,
             side: side as u8,
             log2_cells: (side - 1).trailing_zeros() as u8,
@@ -152,24 +200,21 @@ impl CubeTable {
             ln_load_reciprocal: reciprocal as u32,
             ln_load_shift: (bits - 1) as u8,
             nodes: [0; MAX_NODES],
-        };
-        for row in 0..side {
-            let ln = Q6_26::from_bits(ln_load_low + row as i32 * ln_load_step);
-            let point = table.exact.scene().prepare(ln)?;
-            for column in 0..side {
-                let ratio = table
-                    .exact
-                    .ratio_prepared(&point, table.node_amplitude(column))?;
-                if column > 0 && ratio.to_bits() > table.nodes[row * side + column - 1] {
-                    return Err(ModelError::OutOfDomain {
-                        input: "x",
-                        reason: "F'/F rises with the amplitude: not tabulable",
-                    });
-                }
-                table.nodes[row * side + column] = ratio.to_bits();
+        })
+    }
+
+    /// Every row non-increasing in the amplitude (the inversion's binary search needs it).
+    fn check_rows(&self) -> Result<(), ModelError> {
+        let side = self.side();
+        for row in self.nodes[..side * side].chunks_exact(side) {
+            if row.windows(2).any(|pair| pair[1] > pair[0]) {
+                return Err(ModelError::OutOfDomain {
+                    input: "x",
+                    reason: "F'/F rises with the amplitude: not tabulable",
+                });
             }
         }
-        Ok(table)
+        Ok(())
     }
 
     /// The exact model the table was built from (and falls back to).

@@ -270,3 +270,29 @@ fn a_target_on_a_plateau_is_reached_at_its_smallest_amplitude() {
     // The case exists at this load (not a test that passes by finding no plateau).
     assert!(plateaus >= 1, "{ratios:?}");
 }
+
+/// A table given the nodes `new` computed is `new`'s table; a wrong node count or a row that
+/// rises with the amplitude is refused, as `new` refuses one.
+#[test]
+fn a_table_from_given_nodes_is_the_built_one_and_checks_them() {
+    let built = table(ContactKind::ElasticPlastic, 9);
+    let nodes = built.nodes().to_vec();
+    assert_eq!(nodes.len(), 81);
+    let given = CubeTable::with_nodes(exact(ContactKind::ElasticPlastic), RANGE, 9, &nodes);
+    assert_eq!(given.as_ref(), Ok(&built));
+    let short = CubeTable::with_nodes(exact(ContactKind::ElasticPlastic), RANGE, 9, &nodes[1..]);
+    assert!(matches!(
+        short,
+        Err(ModelError::OutOfDomain {
+            input: "table nodes",
+            ..
+        })
+    ));
+    let mut rising = nodes.clone();
+    rising[9 + 4] = rising[9 + 3] + 1;
+    let refused = CubeTable::with_nodes(exact(ContactKind::ElasticPlastic), RANGE, 9, &rising);
+    assert!(matches!(
+        refused,
+        Err(ModelError::OutOfDomain { input: "x", .. })
+    ));
+}
