@@ -328,7 +328,12 @@ impl Config {
                 period,
             )
             .map_err(ConfigError::Shaper)?,
-            contact_lag: if s.contact_lag_s == 0.0 {
+            // A lag whose step decays below 2^-31 within one period (tau < T / (31 ln 2)) is
+            // the identity at the prediction's Q2.30 resolution: no stage, no cost.
+            contact_lag: if s.contact_lag_s == 0.0
+                || (s.contact_lag_s > 0.0
+                    && s.contact_lag_s * 31.0 * core::f64::consts::LN_2 < period)
+            {
                 None
             } else {
                 let lag = LowPassCoef::from_time_constant(s.contact_lag_s, period);

@@ -411,6 +411,12 @@ mod tests {
             compliant.contact_lag_s
         );
         assert!((observation_lag_s(&compliant) - observation_lag_s(&s) - 0.487_0e-3).abs() < 1e-6);
+        // The reference's 1.1 us contact lag is the identity at 10 kHz: no stage; compliant's
+        // 0.49 ms is one.
+        let config = crate::control::Config::new(&s).expect("valid");
+        assert!(config.contact_lag.is_none());
+        let config = crate::control::Config::new(&compliant).expect("valid");
+        assert!(config.contact_lag.is_some());
         assert!((s.tangential_force_range_n - 2.2).abs() < 1e-12);
         assert_eq!(s.velocity_range_m_s, 5.0);
         assert!(crate::control::Config::new(&s).is_ok());
