@@ -122,11 +122,12 @@ impl<'a> Run<'a> {
             format!(" (undocumented keys: {})", status.extra_keys.join(","))
         };
         Ok(format!(
-            "firmware={} board={} protocol={}; status has all 13 fields: state={} scene={} \
-             target={} mu={} amp={} overruns={} fault={}{extra}",
+            "firmware={} board={} protocol={}; status has all {} fields: state={} scene={} \
+             target={} mu={} amp={} overruns={} fault={} reach={} resonance={}{extra}",
             version.firmware,
             version.board,
             version.protocol,
+            super::STATUS_KEYS.len(),
             status.state.name(),
             status.scene.as_deref().unwrap_or("none"),
             target_text(status.target.as_ref()),
@@ -134,6 +135,8 @@ impl<'a> Run<'a> {
             fixed(i64::from(status.drive_amplitude_ppm), 6),
             status.overruns,
             status.fault.as_deref().unwrap_or("none"),
+            status.reach,
+            status.resonance,
         ))
     }
 
