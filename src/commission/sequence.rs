@@ -189,9 +189,8 @@ impl Commissioning {
                 }
             }
             Step::RingDown if !self.ring_down_closed => {
-                if !self.ring_down.push(group_amplitude_lsb(amplitude_squared)) {
-                    self.ring_down_closed = true;
-                }
+                self.ring_down_closed =
+                    !self.ring_down.push(group_amplitude_lsb(amplitude_squared));
             }
             _ => {}
         }
