@@ -7,8 +7,7 @@ use super::{
 };
 use crate::fx::{Q1_31, Q16_16};
 use crate::resonance::{
-    LockState, RING_DOWN_FLOOR_LSB, RING_DOWN_SPAN_TIME_CONSTANTS, ResonanceReport, fit_ring_down,
-    group_amplitude_lsb, group_amplitude_squared,
+    LockState, ResonanceReport, RingDownSums, group_amplitude_lsb, group_amplitude_squared,
 };
 
 /// The step commissioning is in (or failed in).
@@ -56,20 +55,6 @@ pub enum Phase {
     Done(Result<CommissionResult, Refusal>),
 }
 
-/// Ring-down groups held: 256 (1024 drive periods; three time constants of Q = 800 at 40 kHz.
-/// A longer ring-down fits its first 256 groups, still above the floor). Each is held as
-/// `16 A` in a `u16` (1/16 LSB, a hundredth of the sense's noise; `A` is at most
-/// `2048 sqrt 2 = 2896` LSB, `16 A` below 46 341): 512 bytes in the station.
-const RING_DOWN_CAPACITY: usize = 256;
-
-/// Control periods of the burst's detuning window: the last 32 settled ones.
-const DETUNING_WINDOW: usize = 32;
-
-/// `16 A` of a group's `4 A^2` (`sqrt(64 x 4 A^2)`), exact integer square root, rounded down.
-fn sixteenths(amplitude_squared_x4: u64) -> u16 {
-    (amplitude_squared_x4.saturating_mul(64).isqrt()).min(u64::from(u16::MAX)) as u16
-}
-
 /// Longest any one step may take, s: one second (a search, a burst of Q = 5000 at 20 kHz,
 /// 12 time constants, or a contact that never slides).
 const STEP_LIMIT_S: f64 = 1.0;
@@ -88,11 +73,12 @@ pub struct Commissioning {
     /// The last group's `4 A^2`, LSB^2 (burst).
     last_group: u64,
     settled_groups: u32,
-    /// (drive frequency mHz, detuning Q8.24 bits) of the settled burst periods, a ring.
-    detuning: [(u32, i32); DETUNING_WINDOW],
-    detuning_count: usize,
-    ring_down: [u16; RING_DOWN_CAPACITY],
-    ring_down_len: usize,
+    /// Sums over the settled burst periods of `f - f_ref` and `f d` (Hz; `d` the detuning)
+    /// and of their squares and product, for f0's mean and standard error; `f_ref` is the
+    /// first settled period's frequency (the sums then stay small).
+    detuning: DetuningSums,
+    /// The ring-down's fit, one group at a time.
+    ring_down: RingDownSums,
     ring_down_closed: bool,
     /// Drive frequency over the ring-down, mHz.
     ring_down_frequency_mhz: u32,
@@ -150,10 +136,8 @@ impl Commissioning {
             group_len: 0,
             last_group: 0,
             settled_groups: 0,
-            detuning: [(0, 0); DETUNING_WINDOW],
-            detuning_count: 0,
-            ring_down: [0; RING_DOWN_CAPACITY],
-            ring_down_len: 0,
+            detuning: DetuningSums::EMPTY,
+            ring_down: RingDownSums::new(),
             ring_down_closed: false,
             ring_down_frequency_mhz: 0,
             time_constant: none,
@@ -201,28 +185,12 @@ impl Commissioning {
                     self.settled_groups += 1;
                 } else {
                     self.settled_groups = 0;
-                    self.detuning_count = 0;
+                    self.detuning = DetuningSums::EMPTY;
                 }
             }
             Step::RingDown if !self.ring_down_closed => {
-                let amplitude = sixteenths(amplitude_squared);
-                let amplitude_lsb = f64::from(amplitude) / 16.0;
-                let first = self
-                    .ring_down
-                    .first()
-                    .filter(|_| self.ring_down_len > 0)
-                    .map_or(amplitude_lsb, |&a| f64::from(a) / 16.0);
-                let floor = libm::fmax(
-                    first * libm::exp(-RING_DOWN_SPAN_TIME_CONSTANTS),
-                    RING_DOWN_FLOOR_LSB,
-                );
-                match self.ring_down.get_mut(self.ring_down_len) {
-                    Some(slot) if amplitude_lsb >= floor => {
-                        *slot = amplitude;
-                        self.ring_down_len += 1;
-                    }
-                    _ => self.ring_down_closed = true,
-                }
+                self.ring_down_closed =
+                    !self.ring_down.push(group_amplitude_lsb(amplitude_squared));
             }
             _ => {}
         }
@@ -265,13 +233,10 @@ impl Commissioning {
                 if self.settled_groups > 0
                     && let Some(detuning) = inputs.resonance.detuning
                 {
-                    let slot = self.detuning_count % DETUNING_WINDOW;
-                    if let Some(entry) = self.detuning.get_mut(slot) {
-                        *entry = (inputs.resonance.frequency.millihertz(), detuning.to_bits());
-                    }
-                    self.detuning_count += 1;
+                    self.detuning
+                        .add(inputs.resonance.frequency.millihertz(), detuning.to_bits());
                 }
-                if self.settled_groups >= SETTLED_GROUPS && self.detuning_count >= 2 {
+                if self.settled_groups >= SETTLED_GROUPS && self.detuning.count >= 2 {
                     self.ring_down_frequency_mhz = inputs.resonance.frequency.millihertz();
                     self.enter(Step::RingDown);
                     Phase::DriveOffPinned
@@ -327,13 +292,7 @@ impl Commissioning {
     /// tau from the ring-down, then f0 from the burst's detuning with the measured Q.
     fn fit(&mut self) -> Result<(), Refusal> {
         let f_hz = f64::from(self.ring_down_frequency_mhz) / 1e3;
-        let points = self
-            .ring_down
-            .get(..self.ring_down_len)
-            .unwrap_or(&[])
-            .iter()
-            .map(|&a| f64::from(a) / 16.0);
-        let fit = fit_ring_down(points, 4.0 / f_hz).map_err(|e| {
+        let fit = self.ring_down.fit(4.0 / f_hz).map_err(|e| {
             let value = match e {
                 crate::resonance::RingDownError::TooSmall(lsb) => lsb,
                 crate::resonance::RingDownError::TooShort(n) => f64::from(n),
@@ -350,26 +309,8 @@ impl Commissioning {
         // from the detuning with that Q, then Q again from f0.
         let tau = fit.time_constant_s;
         let first_q = core::f64::consts::PI * f_hz * tau;
-        let n = self.detuning_count.min(DETUNING_WINDOW);
-        let resonance_at = |&(mhz, bits): &(u32, i32)| {
-            let f = f64::from(mhz) / 1e3;
-            let detuning = f64::from(bits) / f64::from(1u32 << 24);
-            f * (1.0 - detuning / (2.0 * first_q))
-        };
-        let window = self.detuning.get(..n).unwrap_or(&[]);
-        let mean = window.iter().map(resonance_at).sum::<f64>() / n as f64;
-        let variance = window
-            .iter()
-            .map(|e| {
-                let d = resonance_at(e) - mean;
-                d * d
-            })
-            .sum::<f64>()
-            / (n as f64 - 1.0);
-        self.resonance = Measured {
-            value: mean,
-            standard_error: libm::sqrt(variance / n as f64),
-        };
+        self.resonance = self.detuning.resonance(first_q);
+        let mean = self.resonance.value;
         let q = core::f64::consts::PI * mean * tau;
         let relative = libm::hypot(
             fit.time_constant_se_s / tau,
@@ -400,5 +341,63 @@ impl Commissioning {
         };
         check(&result)?;
         Ok(result)
+    }
+}
+
+/// The sums behind f0: per settled burst period `y = f (1 - d / 2Q)` with `f` the drive
+/// frequency and `d` the detuning; kept as sums of `a = f - f_ref` and `b = f d` so that Q can
+/// come later (`y - f_ref = a - b / 2Q`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct DetuningSums {
+    count: u32,
+    reference_mhz: u32,
+    sum_a: f64,
+    sum_b: f64,
+    sum_aa: f64,
+    sum_bb: f64,
+    sum_ab: f64,
+}
+
+impl DetuningSums {
+    const EMPTY: Self = Self {
+        count: 0,
+        reference_mhz: 0,
+        sum_a: 0.0,
+        sum_b: 0.0,
+        sum_aa: 0.0,
+        sum_bb: 0.0,
+        sum_ab: 0.0,
+    };
+
+    /// One period: drive frequency in mHz, detuning Q8.24 bits (half-bandwidths).
+    fn add(&mut self, frequency_mhz: u32, detuning_bits: i32) {
+        if self.count == 0 {
+            self.reference_mhz = frequency_mhz;
+        }
+        let f = f64::from(frequency_mhz) / 1e3;
+        let a = (f64::from(frequency_mhz) - f64::from(self.reference_mhz)) / 1e3;
+        let b = f * f64::from(detuning_bits) / f64::from(1u32 << 24);
+        self.sum_a += a;
+        self.sum_b += b;
+        self.sum_aa += a * a;
+        self.sum_bb += b * b;
+        self.sum_ab += a * b;
+        self.count += 1;
+    }
+
+    /// f0 and the standard error of its mean, with the quality factor `q`.
+    fn resonance(&self, q: f64) -> Measured {
+        let n = f64::from(self.count);
+        let k = 1.0 / (2.0 * q);
+        let mean = (self.sum_a - k * self.sum_b) / n;
+        let centred = |sum_xy: f64, sum_x: f64, sum_y: f64| sum_xy - sum_x * sum_y / n;
+        let variance = (centred(self.sum_aa, self.sum_a, self.sum_a)
+            + k * k * centred(self.sum_bb, self.sum_b, self.sum_b)
+            - 2.0 * k * centred(self.sum_ab, self.sum_a, self.sum_b))
+            / (n - 1.0);
+        Measured {
+            value: f64::from(self.reference_mhz) / 1e3 + mean,
+            standard_error: libm::sqrt(libm::fmax(variance, 0.0) / n),
+        }
     }
 }

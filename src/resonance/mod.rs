@@ -83,8 +83,8 @@ pub use motional::{ClampedCapacitance, MAX_DETUNING, detuning};
 pub use phasor::{Angle, Phasor, Polar};
 pub use ringdown::{
     MIN_RING_DOWN_POINTS, MIN_RING_DOWN_START_LSB, RING_DOWN_FLOOR_LSB,
-    RING_DOWN_SPAN_TIME_CONSTANTS, RingDownError, RingDownFit, fit_ring_down, group_amplitude_lsb,
-    group_amplitude_squared,
+    RING_DOWN_SPAN_TIME_CONSTANTS, RingDownError, RingDownFit, RingDownSums, fit_ring_down,
+    group_amplitude_lsb, group_amplitude_squared,
 };
 pub use search::{Lock, Search, SearchConfig, SearchSettings, SearchStep};
 pub use stack::{StackModel, StackSettings};

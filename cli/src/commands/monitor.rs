@@ -95,8 +95,10 @@ pub fn run(args: &[String]) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    if options.steps.is_empty() && !options.acceptance {
-        eprint!("sonolube monitor: nothing to do: give -c, --script or --acceptance\n\n{USAGE}");
+    if options.steps.is_empty() && !options.acceptance && !options.commission {
+        eprint!(
+            "sonolube monitor: nothing to do: give -c, --script, --commission or --acceptance\n\n{USAGE}"
+        );
         return ExitCode::from(2);
     }
     for path in [&options.csv, &options.svg].into_iter().flatten() {
