@@ -425,7 +425,9 @@ mod tests {
     #[test]
     fn the_controller_accepts_exactly_the_schemas_control_rates() {
         // Issue 26: the schema allowed 1e3 Hz while the controller refused below 6e3 Hz. Both
-        // ends of the one range build; just below its low end the fast PI step is refused.
+        // ends of the one range build. (Below it the gains would still be valid: the rule's
+        // sampled cap keeps `ki T <= 1 - m - kp` at any period; 6e3 Hz stays the schema's low
+        // end because no scene below it has been run or measured.)
         let scene = find("reference").expect("built in");
         let at = |rate_hz: f64| {
             let scene = crate::scene::Scene {
@@ -437,7 +439,6 @@ mod tests {
         let (low, high) = crate::scene::CONTROL_RATE_RANGE_HZ;
         assert!(at(low).is_ok());
         assert!(at(high).is_ok());
-        assert!(at(low * (1.0 - 1e-9)).is_err());
     }
 
     #[test]
