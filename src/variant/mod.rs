@@ -146,7 +146,7 @@ pub struct Variant {
     /// at scene start and interpolated bilinearly ([`crate::model::cube_table`]: 5, 9 or 17);
     /// for the Dahl steady state, of F_avg / (mu W) over (mu_i(zeta), ln kappa x_a) compiled
     /// into flash from the f64 reference and interpolated bicubically
-    /// ([`crate::model::dahl_table`]: 33 or 65, alpha = 1). Fixed point only; 0 for a variant
+    /// ([`crate::model::dahl_table`]: 65 or 129, alpha = 1). Fixed point only; 0 for a variant
     /// that evaluates its model directly.
     pub table: u8,
 }
@@ -197,8 +197,8 @@ pub const CATALOGUE: &[Variant] = variants! {
     "Dahl steady N=64 f32 micromath" => DahlSteady, F32Micromath, 64;
     "Dahl steady N=64 f32 libm" => DahlSteady, F32Libm, 64;
     "Dahl steady N=64 f64" => DahlSteady, F64, 64;
-    "Dahl steady T=33x33" => DahlSteady, Fixed, 64, T 33;
     "Dahl steady T=65x65" => DahlSteady, Fixed, 64, T 65;
+    "Dahl steady T=129x129" => DahlSteady, Fixed, 64, T 129;
     "cube el N=4" => CubeElastic, Fixed, 4;
     "cube el N=4 f32 micromath" => CubeElastic, F32Micromath, 4;
     "cube el N=4 f32 libm" => CubeElastic, F32Libm, 4;
@@ -291,16 +291,16 @@ pub const CONTROL_STEPS: &[(&str, &str, Fidelity, u8)] = &[
         0,
     ),
     (
-        "control step Dahl steady T=33x33",
-        "compliant",
-        Fidelity::DahlSteady,
-        33,
-    ),
-    (
         "control step Dahl steady T=65x65",
         "compliant",
         Fidelity::DahlSteady,
         65,
+    ),
+    (
+        "control step Dahl steady T=129x129",
+        "compliant",
+        Fidelity::DahlSteady,
+        129,
     ),
     (
         "control step cube el N=16",
