@@ -151,8 +151,13 @@ pub fn interpolant(n: &[f64], side: usize, w: f64, y: f64) -> f64 {
     if y <= top {
         return at(w, y);
     }
-    let zeta = 1.0 - w * w;
-    let x = 2.0 / PI * zeta.asin();
+    let coulomb = |w: f64| 2.0 / PI * (1.0 - w * w).asin();
+    let x = coulomb(w);
+    // As the firmware: by similarity in kappa x_a w^3 near the onset, else 1 / kappa x_a.
+    let w1 = w * ((y - top) / 3.0).exp2();
+    if w < 0.25 && w1 < 1.0 {
+        return x + (at(w1, top) - coulomb(w1)) * w / w1;
+    }
     x + (at(w, top) - x) * (top - y).exp2()
 }
 

@@ -17,19 +17,19 @@ pub static MEASURED: Measurements = Measurements {
 static COSTS: &[Cost] = &[
     Cost {
         variant: "Littmann closed form",
-        instructions: 42.182,
+        instructions: 46.625,
     },
     Cost {
         variant: "Littmann closed form f32 micromath",
-        instructions: 30.885,
+        instructions: 30.904,
     },
     Cost {
         variant: "Littmann closed form f32 libm",
-        instructions: 414.858,
+        instructions: 414.782,
     },
     Cost {
         variant: "Littmann closed form f64",
-        instructions: 3355.998,
+        instructions: 3356.017,
     },
     Cost {
         variant: "Dahl update",
@@ -37,7 +37,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl update f32 micromath",
-        instructions: 107.247,
+        instructions: 107.213,
     },
     Cost {
         variant: "Dahl update f32 libm",
@@ -45,23 +45,23 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl update f64",
-        instructions: 2228.068,
+        instructions: 2228.102,
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 315.196,
+        instructions: 296.078,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 68.872,
+        instructions: 68.774,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 259.166,
+        instructions: 259.117,
     },
     Cost {
         variant: "Coulomb ratio f64",
-        instructions: 2720.049,
+        instructions: 2720.147,
     },
     Cost {
         variant: "Dahl steady N=16",
@@ -69,19 +69,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 5869.731,
+        instructions: 5869.462,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 31789.838,
+        instructions: 31789.516,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 147230.22,
+        instructions: 147229.95,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20281.182,
+        instructions: 20281.129,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
@@ -89,35 +89,35 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 58561.29,
+        instructions: 58561.02,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 269833.94,
+        instructions: 269832.16,
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 37995.97,
+        instructions: 37995.645,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22175.912,
+        instructions: 22176.129,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 111755.86,
+        instructions: 111756.34,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 511146.56,
-    },
-    Cost {
-        variant: "Dahl steady T=33x33",
-        instructions: 910.698,
+        instructions: 511145.97,
     },
     Cost {
         variant: "Dahl steady T=65x65",
-        instructions: 912.043,
+        instructions: 376.989,
+    },
+    Cost {
+        variant: "Dahl steady T=129x129",
+        instructions: 364.623,
     },
     Cost {
         variant: "cube el N=4",
@@ -125,15 +125,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
-        instructions: 378.03,
+        instructions: 377.878,
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 260.454,
+        instructions: 260.303,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9423.484,
+        instructions: 9423.939,
     },
     Cost {
         variant: "cube el N=8",
@@ -141,15 +141,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 631.969,
+        instructions: 631.666,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
-        instructions: 388.333,
+        instructions: 388.484,
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15229.09,
+        instructions: 15228.939,
     },
     Cost {
         variant: "cube el N=16",
@@ -157,7 +157,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
-        instructions: 1141.969,
+        instructions: 1141.818,
     },
     Cost {
         variant: "cube el N=16 f32 libm",
@@ -165,15 +165,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26879.848,
+        instructions: 26879.545,
     },
     Cost {
         variant: "cube el N=32",
-        instructions: 2258.03,
+        instructions: 2257.878,
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.363,
+        instructions: 2161.666,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
@@ -181,15 +181,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50123.18,
+        instructions: 50122.426,
     },
     Cost {
         variant: "cube el T=5x5",
-        instructions: 282.575,
+        instructions: 282.727,
     },
     Cost {
         variant: "cube el T=9x9",
-        instructions: 282.727,
+        instructions: 282.878,
     },
     Cost {
         variant: "cube el T=17x17",
@@ -197,11 +197,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 592.121,
+        instructions: 591.666,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 378.181,
+        instructions: 377.878,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
@@ -209,15 +209,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9414.696,
+        instructions: 9414.393,
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 830.0,
+        instructions: 829.696,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 632.121,
+        instructions: 631.969,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
@@ -225,15 +225,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=8 f64",
-        instructions: 15216.212,
+        instructions: 15216.515,
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1305.757,
+        instructions: 1305.606,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
-        instructions: 1141.666,
+        instructions: 1142.121,
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
@@ -241,7 +241,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26868.182,
+        instructions: 26867.879,
     },
     Cost {
         variant: "cube ep N=32",
@@ -253,19 +253,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
-        instructions: 1162.878,
+        instructions: 1163.181,
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50111.06,
+        instructions: 50110.453,
     },
     Cost {
         variant: "cube ep T=5x5",
-        instructions: 282.878,
+        instructions: 282.575,
     },
     Cost {
         variant: "cube ep T=9x9",
-        instructions: 283.03,
+        instructions: 282.727,
     },
     Cost {
         variant: "cube ep T=17x17",
@@ -320,16 +320,16 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "compliant",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=65x65",
         reference: Fidelity::DahlSteady,
-        max_error: 4.09e-6,
+        max_error: 1.06e-6,
         points: 24,
     },
     SceneError {
         scene: "compliant",
-        variant: "Dahl steady T=65x65",
+        variant: "Dahl steady T=129x129",
         reference: Fidelity::DahlSteady,
-        max_error: 8.27e-7,
+        max_error: 1.09e-7,
         points: 24,
     },
     SceneError {
@@ -810,16 +810,16 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "reference",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=65x65",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000254,
+        max_error: 8.66e-5,
         points: 24,
     },
     SceneError {
         scene: "reference",
-        variant: "Dahl steady T=65x65",
+        variant: "Dahl steady T=129x129",
         reference: Fidelity::DahlSteady,
-        max_error: 2.29e-5,
+        max_error: 9.79e-6,
         points: 24,
     },
     SceneError {
@@ -859,16 +859,16 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "resonance-drift",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=65x65",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000382,
+        max_error: 8.93e-5,
         points: 120,
     },
     SceneError {
         scene: "resonance-drift",
-        variant: "Dahl steady T=65x65",
+        variant: "Dahl steady T=129x129",
         reference: Fidelity::DahlSteady,
-        max_error: 3.21e-5,
+        max_error: 1.08e-5,
         points: 120,
     },
     SceneError {
@@ -908,16 +908,16 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "resonance-search",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=65x65",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000184,
+        max_error: 7.33e-5,
         points: 24,
     },
     SceneError {
         scene: "resonance-search",
-        variant: "Dahl steady T=65x65",
+        variant: "Dahl steady T=129x129",
         reference: Fidelity::DahlSteady,
-        max_error: 2.62e-5,
+        max_error: 7.32e-6,
         points: 24,
     },
     SceneError {
@@ -957,16 +957,16 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "seatbelt",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=65x65",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000854,
+        max_error: 0.000223,
         points: 360,
     },
     SceneError {
         scene: "seatbelt",
-        variant: "Dahl steady T=65x65",
+        variant: "Dahl steady T=129x129",
         reference: Fidelity::DahlSteady,
-        max_error: 6.55e-5,
+        max_error: 1.83e-5,
         points: 360,
     },
     SceneError {
@@ -1006,16 +1006,16 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "sensor-fault",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=65x65",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000254,
+        max_error: 8.66e-5,
         points: 24,
     },
     SceneError {
         scene: "sensor-fault",
-        variant: "Dahl steady T=65x65",
+        variant: "Dahl steady T=129x129",
         reference: Fidelity::DahlSteady,
-        max_error: 2.29e-5,
+        max_error: 9.79e-6,
         points: 24,
     },
     SceneError {
@@ -1055,16 +1055,16 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "sensor-spike",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=65x65",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000254,
+        max_error: 8.66e-5,
         points: 24,
     },
     SceneError {
         scene: "sensor-spike",
-        variant: "Dahl steady T=65x65",
+        variant: "Dahl steady T=129x129",
         reference: Fidelity::DahlSteady,
-        max_error: 2.29e-5,
+        max_error: 9.79e-6,
         points: 24,
     },
     SceneError {
@@ -1104,16 +1104,16 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "sensor-stuck",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=65x65",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000254,
+        max_error: 8.66e-5,
         points: 24,
     },
     SceneError {
         scene: "sensor-stuck",
-        variant: "Dahl steady T=65x65",
+        variant: "Dahl steady T=129x129",
         reference: Fidelity::DahlSteady,
-        max_error: 2.29e-5,
+        max_error: 9.79e-6,
         points: 24,
     },
     SceneError {
@@ -1153,16 +1153,16 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "stack-rail",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=65x65",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000124,
+        max_error: 4.36e-5,
         points: 120,
     },
     SceneError {
         scene: "stack-rail",
-        variant: "Dahl steady T=65x65",
+        variant: "Dahl steady T=129x129",
         reference: Fidelity::DahlSteady,
-        max_error: 1.29e-5,
+        max_error: 4.38e-6,
         points: 120,
     },
 ];

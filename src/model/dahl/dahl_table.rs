@@ -22,9 +22,12 @@
 //!
 //! Beyond the table: below y = -20 (kappa x_a < 1e-6) R is the soft limit
 //! (D_f - D_b) / (D_f + D_b) to within O(kappa x_a): the table's bottom row is used. Above
-//! y = 12 (kappa x_a > 4096) R is extrapolated towards the Coulomb limit x = mu_i(zeta) as
-//! x + (R(w, 12) - x) 2^-(y - 12) (the correction decays as 1 / (kappa x_a)); only there is
-//! asin evaluated.
+//! y = 12 (kappa x_a > 4096) R is extrapolated towards the Coulomb limit x = mu_i(zeta): the
+//! correction R - x decays as c(w) / (kappa x_a) (the reference: (R - x) kappa x_a changes by
+//! less than 1 % from kappa x_a = 2^12 to 2^20 for w >= 0.35), except in a boundary layer
+//! near the onset (zeta -> 1) of width w ~ (kappa x_a)^(-1/3), where R - x = w G(kappa x_a w^3)
+//! and the extrapolation goes by that similarity ([`DahlTable::stiff`]). Only there is asin
+//! evaluated.
 //!
 //! The inverse (the amplitude for a target ratio): at a fixed operating point
 //! tau = zeta kappa x_a = kappa |v| / omega does not depend on the amplitude, so the amplitudes
@@ -56,6 +59,8 @@ pub const GUESS_SIDE: usize = 65;
 const GUESS_STEPS_LOG2: u32 = 6;
 /// Newton steps of the inverse after the start table.
 const NEWTON_STEPS: u32 = 2;
+/// Newton steps of the inverse where the curve leaves the table's stiff end.
+const STIFF_STEPS: u32 = 5;
 /// round(2^30 ln 2).
 const LN2_Q30: i64 = 744_261_118;
 /// round(2^30 * 2 / ln 2): dy/dw = 2 w / (zeta ln 2) in binary orders per unit of w.
@@ -148,28 +153,39 @@ fn quotient_q32(num: i64, den: i64) -> i64 {
 }
 
 /// The four Catmull-Rom weights at fraction `t` (Q.30, [0, 1]), in Q.30 (each within
-/// [-0.15, 1]: `i32`, so that the products below are single `SMULL`/`SMLAL`s).
+/// [-0.15, 1], summing to 1 within 4 units): 32-bit arithmetic around two `SMULL`s. The
+/// intermediate sums may leave the `i32` range, the weights do not: wrapping sums are exact.
 #[inline]
-fn weights(t: i64) -> [i32; 4] {
-    let t2 = (t * t) >> 30;
-    let t3 = (t2 * t) >> 30;
+fn weights(t: i32) -> [i32; 4] {
+    let t2 = ((t as i64 * t as i64) >> 30) as i32;
+    let t3 = ((t2 as i64 * t as i64) >> 30) as i32;
+    let (h, h2, h3) = (t >> 1, t2 >> 1, t3 >> 1);
     [
-        ((-t3 + 2 * t2 - t) >> 1) as i32,
-        ((3 * t3 - 5 * t2 + (2 << 30)) >> 1) as i32,
-        ((-3 * t3 + 4 * t2 + t) >> 1) as i32,
-        ((t3 - t2) >> 1) as i32,
+        t2 - h3 - h,
+        (1i32 << 30)
+            .wrapping_add(h3.wrapping_mul(3))
+            .wrapping_sub(h2.wrapping_mul(5)),
+        h.wrapping_add(t2.wrapping_mul(2))
+            .wrapping_sub(h3.wrapping_mul(3)),
+        h3 - h2,
     ]
 }
 
-/// The derivatives of [`weights`] in t, Q.30 (each within [-1.5, 1.5]).
+/// The derivatives of [`weights`] in t, Q.30 (each within [-1.5, 1.5]; wrapping sums as
+/// there).
 #[inline]
-fn weight_slopes(t: i64) -> [i32; 4] {
-    let t2 = (t * t) >> 30;
+fn weight_slopes(t: i32) -> [i32; 4] {
+    let t2 = ((t as i64 * t as i64) >> 30) as i32;
+    let (h, h2) = (t >> 1, t2 >> 1);
     [
-        ((-3 * t2 + 4 * t - (1 << 30)) >> 1) as i32,
-        ((9 * t2 - 10 * t) >> 1) as i32,
-        ((-9 * t2 + 8 * t + (1 << 30)) >> 1) as i32,
-        ((3 * t2 - 2 * t) >> 1) as i32,
+        t.wrapping_mul(2)
+            .wrapping_sub(h2.wrapping_mul(3))
+            .wrapping_sub(1 << 29),
+        h2.wrapping_mul(9).wrapping_sub(h.wrapping_mul(10)),
+        h.wrapping_mul(8)
+            .wrapping_sub(h2.wrapping_mul(9))
+            .wrapping_add(1 << 29),
+        h2.wrapping_mul(3).wrapping_sub(t),
     ]
 }
 
@@ -209,40 +225,48 @@ impl DahlGrid {
         self.side + 2
     }
 
-    /// Four nodes from `at` (an index the splits keep inside the padded table: a failed
-    /// lookup, which cannot happen, reads as zeros rather than panicking).
-    #[inline]
-    fn four(&self, at: usize) -> [i32; 4] {
-        match self.nodes.get(at..at + 4) {
-            Some(&[a, b, c, d]) => [a, b, c, d],
-            _ => [0; 4],
-        }
-    }
-
     /// Cells and fractions (Q.30) of w (Q0.32) and of the y offset `d` (Q8.24 in [0, 32]).
     #[inline]
-    fn split<const K: u32>(w: u32, d: i32) -> (usize, i64, usize, i64) {
+    fn split<const K: u32>(w: u32, d: i32) -> (usize, i32, usize, i32) {
         let i = (w >> (32 - K)) as usize;
-        let tx = ((w << K) >> 2) as i64;
+        let tx = ((w << K) >> 2) as i32;
         let p = ((d as i64) << K) >> SPAN_LOG2; // Q.24 position in nodes
         let j = (p >> 24) as usize;
         if j >= 1 << K {
             return (i, tx, (1 << K) - 1, 1 << 30);
         }
-        (i, tx, j, (p & ((1 << 24) - 1)) << 6)
+        (i, tx, j, ((p & ((1 << 24) - 1)) << 6) as i32)
     }
 
-    /// The four rows (in w) of the 4 x 4 block around (w, d), interpolated in y with `wy`.
+    /// The 4 x 4 nodes around cell (i, j), one bounds check (a failed lookup, which the splits
+    /// rule out, reads as zeros rather than panicking).
     #[inline]
-    fn rows<const K: u32>(&self, i: usize, j: usize, wy: &[i32; 4]) -> [i32; 4] {
+    fn block<const K: u32>(&self, i: usize, j: usize) -> [[i32; 4]; 4] {
         let stride = (1 << K) + 3;
         // Node (i - 1, j - 1) sits at padded (i, j).
         let base = i * stride + j;
+        let Some(b) = self.nodes.get(base..base + 3 * stride + 4) else {
+            return [[0; 4]; 4];
+        };
+        let row = |r: usize| {
+            [
+                b[r * stride],
+                b[r * stride + 1],
+                b[r * stride + 2],
+                b[r * stride + 3],
+            ]
+        };
+        [row(0), row(1), row(2), row(3)]
+    }
+
+    /// The four rows (in w) of a block, interpolated in y with `wy`.
+    #[inline]
+    fn rows(block: &[[i32; 4]; 4], wy: &[i32; 4]) -> [i32; 4] {
         [
-            dot(wy, &self.four(base)),
-            dot(wy, &self.four(base + stride)),
-            dot(wy, &self.four(base + 2 * stride)),
-            dot(wy, &self.four(base + 3 * stride)),
+            dot(wy, &block[0]),
+            dot(wy, &block[1]),
+            dot(wy, &block[2]),
+            dot(wy, &block[3]),
         ]
     }
 
@@ -259,7 +283,7 @@ impl DahlGrid {
 
     fn bicubic_k<const K: u32>(&self, w: u32, d: i32) -> i64 {
         let (i, tx, j, ty) = Self::split::<K>(w, d);
-        let rows = self.rows::<K>(i, j, &weights(ty));
+        let rows = Self::rows(&self.block::<K>(i, j), &weights(ty));
         dot(&weights(tx), &rows) as i64
     }
 
@@ -274,8 +298,9 @@ impl DahlGrid {
 
     fn slope_k<const K: u32>(&self, w: u32, d: i32) -> Slope {
         let (i, tx, j, ty) = Self::split::<K>(w, d);
-        let rows = self.rows::<K>(i, j, &weights(ty));
-        let row_slopes = self.rows::<K>(i, j, &weight_slopes(ty));
+        let block = self.block::<K>(i, j);
+        let rows = Self::rows(&block, &weights(ty));
+        let row_slopes = Self::rows(&block, &weight_slopes(ty));
         let wx = weights(tx);
         Slope {
             value: dot(&wx, &rows) as i64,
@@ -307,7 +332,7 @@ fn domain(input: &'static str, reason: &'static str) -> ModelError {
 /// log2 of a positive f64 (scene load), Q8.24, or `OutOfDomain` beyond +-127.
 fn log2_q24_f64(x: f64, input: &'static str) -> Result<i32, ModelError> {
     let l = libm::log2(x);
-    if !(l.abs() < 127.0) {
+    if l.is_nan() || l.abs() >= 127.0 {
         return Err(domain(input, "kappa x_a or tau beyond 2^+-127"));
     }
     Ok(libm::round(l * 16_777_216.0) as i32)
@@ -380,28 +405,60 @@ impl DahlTable {
         s
     }
 
-    /// Beyond the stiff end, `beyond` (Q8.24 binary orders) above it: x + (R(w, top) - x) q,
-    /// q = 2^-beyond, x = mu_i(zeta). Slope in w: the Coulomb limit's, -(4/pi) / sqrt(1 + zeta)
-    /// (1 / sqrt(1 + zeta) to 2 % by a line), weighted by 1 - q, plus the edge's weighted by q;
-    /// in y: -(R(w, top) - x) q ln 2.
+    /// Beyond the stiff end, `beyond` (Q8.24 binary orders) above it, towards the Coulomb
+    /// limit x = mu_i(zeta) (measured with the reference: `host-tests/examples`-free, see the
+    /// module docs). R - x = w G(kappa x_a w^3) near zeta = 1 (the backward stretch's
+    /// travel, kappa x_a w^3, sets the boundary layer) and R - x ~ c(w) / (kappa x_a) once
+    /// kappa x_a w^3 is large, so:
+    /// - for w < 1/4, by similarity from the top row at w' = w 2^(beyond / 3) (the same
+    ///   kappa x_a w^3): R = x + (R(w', top) - x(w')) w / w';
+    /// - otherwise (or where w' >= 1: R - x < 3e-5 w there), R = x + (R(w, top) - x) 2^-beyond.
+    ///
+    /// Slopes: the Coulomb limit's, -(4/pi) / sqrt(1 + zeta) (1 / sqrt(1 + zeta) to 2 % by a
+    /// line), and the excess's; they serve the inverse's Newton steps only.
     fn stiff(&self, w: u32, zeta: u32, beyond: i64) -> Slope {
-        let edge = self.grid.slope(w, 32 << 24);
-        let x = mu_i(Q2_30::from_bits((zeta >> 2) as i32)).map_or(0, |x| x.to_bits() as i64);
-        let beyond_ln = (beyond * LN2_Q30) >> 30; // Q8.24 nepers
-        let q = if beyond_ln >= 127 << 24 {
-            0
-        } else {
-            Q8_24::from_bits(beyond_ln as i32)
-                .exp_neg()
-                .map_or(0, |q| q.to_bits() as i64)
+        let coulomb_slope = |z: u32| {
+            let inv_root = (1i64 << 30) - ((314_491_699i64 * z as i64) >> 32);
+            -((FOUR_OVER_PI_Q30 * inv_root) >> 30)
         };
+        let coulomb =
+            |z: u32| mu_i(Q2_30::from_bits((z >> 2) as i32)).map_or(0, |x| x.to_bits() as i64);
+        // e^-nepers, Q.30, for nepers in Q8.24 >= 0.
+        let decay = |nepers: i64| {
+            if nepers >= 127 << 24 {
+                0
+            } else {
+                Q8_24::from_bits(nepers as i32)
+                    .exp_neg()
+                    .map_or(0, |q| q.to_bits() as i64)
+            }
+        };
+        let x = coulomb(zeta);
+        let x_w = coulomb_slope(zeta);
+        if w < 1 << 30 {
+            let scale = decay(((beyond * LN2_Q30) >> 30) / 3); // w / w' = 2^(-beyond / 3), Q.30
+            let scale32 = (scale << 2).min(u32::MAX as i64) as u32;
+            if w < scale32 {
+                let w1 = div_frac(w, scale32);
+                let z1 = u32::MAX - ((w1 as u64 * w1 as u64) >> 32) as u32;
+                let edge = self.grid.slope(w1, 32 << 24);
+                let excess = edge.value - coulomb(z1);
+                let excess_w = edge.per_w - coulomb_slope(z1);
+                // d/dy of excess(w') w / w' at fixed w: (excess_w w' - excess) (w / w') ln2 / 3.
+                let per_y = ((((excess_w * (w1 >> 2) as i64) >> 30) - excess) * scale) >> 30;
+                return Slope {
+                    value: (x + ((excess * scale) >> 30)).clamp(0, 1 << 30),
+                    per_w: x_w + excess_w,
+                    per_y: ((per_y * LN2_Q30) >> 30) / 3,
+                };
+            }
+        }
+        let edge = self.grid.slope(w, 32 << 24);
+        let q = decay((beyond * LN2_Q30) >> 30);
         let excess = edge.value - x;
-        // 1 / sqrt(1 + z) ~ 1 - (1 - 1/sqrt 2) z, z = zeta in Q0.32.
-        let inv_root = (1i64 << 30) - ((314_491_699i64 * zeta as i64) >> 32);
-        let coulomb_slope = -((FOUR_OVER_PI_Q30 * inv_root) >> 30);
         Slope {
             value: (x + ((excess * q) >> 30)).clamp(0, 1 << 30),
-            per_w: ((coulomb_slope * ((1 << 30) - q)) >> 30) + ((edge.per_w * q) >> 30),
+            per_w: ((x_w * ((1 << 30) - q)) >> 30) + ((edge.per_w * q) >> 30),
             per_y: -((((excess * q) >> 30) * LN2_Q30) >> 30),
         }
     }
@@ -548,20 +605,32 @@ impl DahlTable {
         let log2_tau = log2_q24(speed) - log2_q24(load as u32) + self.tau_offset;
         let mut w = Self::guess(t, log2_tau) as i64;
         let mut ratio = t;
-        for _ in 0..steps {
+        // Beyond the stiff end the slopes are approximate (`stiff`): Newton converges
+        // linearly there, and takes up to STIFF_STEPS steps.
+        let top = LOG2_KXA_MAX << 24;
+        for step in 0..steps.max(STIFF_STEPS) {
             let w32 = w.clamp(0, u32::MAX as i64) as u32;
             let zeta = u32::MAX - ((w32 as u64 * w32 as u64) >> 32) as u32;
             if zeta == 0 {
                 break;
             }
             let y = log2_tau - (log2_q24(zeta) - (32 << 24));
+            if step >= steps && y <= top {
+                break;
+            }
             let s = self.slope(w32, y, zeta);
+            // The interpolant's slopes are below 4 in magnitude; clamped so that no input
+            // can make the products below overflow.
+            let (per_w, per_y) = (
+                s.per_w.clamp(-8 << 30, 8 << 30),
+                s.per_y.clamp(-8 << 30, 8 << 30),
+            );
             // Multiplied through by zeta: (R - t) zeta / (R_w zeta + R_y 2 w / ln 2).
-            // Q.30 throughout (|R_w| < 4, |R_y| < 1, 2 w / ln 2 < 2.9: every product < 2^63).
+            // Q.30 throughout (|R_w|, |R_y| <= 8, 2 w / ln 2 < 2.9: every product < 2^63).
             let zeta30 = (zeta >> 2) as i64;
             let num = ((s.value - t) * zeta30) >> 30;
             let dy_dw = ((w32 as u64 * TWO_OVER_LN2_Q30 as u64) >> 32) as i64; // 2 w / ln 2
-            let den = ((s.per_w * zeta30) >> 30) + ((s.per_y * dy_dw) >> 30);
+            let den = ((per_w * zeta30) >> 30) + ((per_y * dy_dw) >> 30);
             if den >= 0 {
                 ratio = s.value;
                 break; // not falling: stay (cannot happen on the table's monotone curve)
