@@ -113,31 +113,31 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady T=65x65",
-        instructions: 376.989,
+        instructions: 342.15,
     },
     Cost {
         variant: "Dahl steady T=129x129",
-        instructions: 364.623,
+        instructions: 340.591,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 591.818,
+        instructions: 591.969,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
-        instructions: 377.878,
+        instructions: 378.181,
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 260.303,
+        instructions: 260.454,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9423.939,
+        instructions: 9423.787,
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 830.0,
+        instructions: 829.848,
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
@@ -149,11 +149,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15228.939,
+        instructions: 15228.636,
     },
     Cost {
         variant: "cube el N=16",
-        instructions: 1306.06,
+        instructions: 1305.757,
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
@@ -169,19 +169,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=32",
-        instructions: 2257.878,
+        instructions: 2258.03,
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.666,
+        instructions: 2161.363,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
-        instructions: 1162.878,
+        instructions: 1163.03,
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50122.426,
+        instructions: 50123.785,
     },
     Cost {
         variant: "cube el T=5x5",
@@ -189,23 +189,23 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el T=9x9",
-        instructions: 282.878,
+        instructions: 282.575,
     },
     Cost {
         variant: "cube el T=17x17",
-        instructions: 282.727,
+        instructions: 282.878,
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 591.666,
+        instructions: 592.121,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 377.878,
+        instructions: 378.03,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
-        instructions: 260.303,
+        instructions: 260.151,
     },
     Cost {
         variant: "cube ep N=4 f64",
@@ -213,39 +213,39 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 829.696,
+        instructions: 829.848,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 631.969,
+        instructions: 632.121,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
-        instructions: 388.333,
+        instructions: 388.484,
     },
     Cost {
         variant: "cube ep N=8 f64",
-        instructions: 15216.515,
+        instructions: 15216.212,
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1305.606,
+        instructions: 1305.909,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
-        instructions: 1142.121,
+        instructions: 1141.818,
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 646.969,
+        instructions: 647.272,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26867.879,
+        instructions: 26867.727,
     },
     Cost {
         variant: "cube ep N=32",
-        instructions: 2257.727,
+        instructions: 2257.878,
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
@@ -253,15 +253,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
-        instructions: 1163.181,
+        instructions: 1163.03,
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50110.453,
+        instructions: 50110.91,
     },
     Cost {
         variant: "cube ep T=5x5",
-        instructions: 282.575,
+        instructions: 282.727,
     },
     Cost {
         variant: "cube ep T=9x9",
@@ -269,7 +269,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep T=17x17",
-        instructions: 282.727,
+        instructions: 282.878,
     },
 ];
 
@@ -329,7 +329,7 @@ static ERRORS: &[SceneError] = &[
         scene: "compliant",
         variant: "Dahl steady T=129x129",
         reference: Fidelity::DahlSteady,
-        max_error: 1.09e-7,
+        max_error: 1.04e-7,
         points: 24,
     },
     SceneError {
@@ -1162,7 +1162,7 @@ static ERRORS: &[SceneError] = &[
         scene: "stack-rail",
         variant: "Dahl steady T=129x129",
         reference: Fidelity::DahlSteady,
-        max_error: 4.38e-6,
+        max_error: 4.39e-6,
         points: 120,
     },
 ];
