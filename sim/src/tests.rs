@@ -201,9 +201,10 @@ fn scene_choosing_another_model() -> Scene<'static> {
         .expect("a scene whose choice is not its own model")
 }
 
-/// A scene the committed table did not measure (another name, or a built-in name with other
-/// contents) runs its own controller model, and says so; a budget change alone is still
-/// measured.
+/// A scene the committed table did not measure (a built-in name with other contents) runs its
+/// own controller model, and says so; a renamed copy of a built-in scene is that scene's
+/// measured twin (`variant::select::measured_twin`: the same measurement inputs) and runs its
+/// choice; a budget change alone is still measured.
 #[test]
 fn a_scene_outside_the_table_keeps_its_own_model() {
     use sonolube::model::AnyModel;
@@ -222,18 +223,30 @@ fn a_scene_outside_the_table_keeps_its_own_model() {
         },
         ..horn
     };
-    for unmeasured in [renamed, moved] {
-        let run = ClosedLoop::new(&unmeasured).expect("runs");
-        let own = AnyModel::new(&unmeasured, &unmeasured.controller).expect("own model");
-        let selection = run.station().selection().expect("selected");
-        assert_eq!(selection.variant, None);
-        assert_eq!(
-            selection.reason,
-            Reason::NotMeasured {
-                kind: horn.controller.kind
-            }
-        );
-        assert_eq!(run.station().model(), &own);
+    let twin = ClosedLoop::new(&renamed).expect("runs");
+    assert_eq!(
+        twin.station().selection().map(|s| s.variant),
+        Some(select(&horn).variant)
+    );
+    // Unmeasured, the scene's own model is the choice; its control step must still fit the
+    // period (issue 24), and the horn's exact cube model does not: the run is refused, saying so.
+    let selection = select(&moved);
+    assert_eq!(selection.variant, None);
+    let own = AnyModel::new(&moved, &moved.controller).expect("own model");
+    match ClosedLoop::new(&moved) {
+        Ok(run) => {
+            assert_eq!(
+                selection.reason,
+                Reason::NotMeasured {
+                    kind: horn.controller.kind
+                }
+            );
+            assert_eq!(run.station().model(), &own);
+        }
+        Err(_) => assert!(
+            selection.refused(),
+            "refused without the selection saying so"
+        ),
     }
     // The built-in scene itself runs another model than its own.
     let measured = ClosedLoop::new(&horn).expect("runs");
