@@ -416,22 +416,7 @@ fn control_step(name: &str, scene_name: &str, fidelity: Fidelity, table: u8, shi
             return false;
         }
     };
-    let (mut tally, mut longest) = (Tally::default(), 0u64);
-    while !closed_loop.is_finished() {
-        if closed_loop.plant_phase().is_none() {
-            break;
-        }
-        watchdog::feed();
-        let start = time_driver::cycles();
-        let control = closed_loop.control_phase();
-        let cycles = time_driver::cycles().saturating_sub(start);
-        if control.is_none() || closed_loop.finish_step().is_none() {
-            break;
-        }
-        tally.cycles += cycles as i64;
-        tally.calls += 1;
-        longest = longest.max(cycles);
-    }
+    let (tally, longest) = time_control_phases(&mut closed_loop);
     let Some(milli) = milli_instructions(tally.cycles, tally.calls, shift) else {
         defmt::error!("bench {=str}: no steps", name);
         return false;
@@ -514,6 +499,25 @@ fn variant_step(variant: &Variant, scene_name: &str, shift: u32) -> bool {
             return false;
         }
     };
+    let (tally, longest) = time_control_phases(&mut closed_loop);
+    let Some(milli) = milli_instructions(tally.cycles, tally.calls, shift) else {
+        defmt::error!("bench step {=str}: no steps", variant.name);
+        return false;
+    };
+    defmt::info!(
+        "bench step {=str}: {=u64}.{=u64:03} instructions per call ({=u64} calls, longest {=u64})",
+        variant.name,
+        milli / 1000,
+        milli % 1000,
+        tally.calls,
+        (longest * NS_PER_CYCLE) >> shift
+    );
+    true
+}
+
+/// Runs `closed_loop` to its end, timing each control phase (the plant's phase and the step's
+/// end are not timed): the tally of cycles and the longest phase.
+fn time_control_phases(closed_loop: &mut ClosedLoop) -> (Tally, u64) {
     let (mut tally, mut longest) = (Tally::default(), 0u64);
     while !closed_loop.is_finished() {
         if closed_loop.plant_phase().is_none() {
@@ -530,17 +534,5 @@ fn variant_step(variant: &Variant, scene_name: &str, shift: u32) -> bool {
         tally.calls += 1;
         longest = longest.max(cycles);
     }
-    let Some(milli) = milli_instructions(tally.cycles, tally.calls, shift) else {
-        defmt::error!("bench step {=str}: no steps", variant.name);
-        return false;
-    };
-    defmt::info!(
-        "bench step {=str}: {=u64}.{=u64:03} instructions per call ({=u64} calls, longest {=u64})",
-        variant.name,
-        milli / 1000,
-        milli % 1000,
-        tally.calls,
-        (longest * NS_PER_CYCLE) >> shift
-    );
-    true
+    (tally, longest)
 }
