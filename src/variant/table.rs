@@ -19,11 +19,11 @@ pub static MEASURED: Measurements = Measurements {
 static COSTS: &[Cost] = &[
     Cost {
         variant: "Littmann closed form",
-        instructions: 45.169,
+        instructions: 45.093,
     },
     Cost {
         variant: "Littmann closed form f32 micromath",
-        instructions: 33.872,
+        instructions: 33.853,
     },
     Cost {
         variant: "Littmann closed form f32 libm",
@@ -31,59 +31,59 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Littmann closed form f64",
-        instructions: 3356.093,
+        instructions: 3356.017,
     },
     Cost {
         variant: "Dahl update",
-        instructions: 43.829,
+        instructions: 39.897,
     },
     Cost {
         variant: "Dahl update f32 micromath",
-        instructions: 107.247,
+        instructions: 107.282,
     },
     Cost {
         variant: "Dahl update f32 libm",
-        instructions: 60.239,
+        instructions: 61.504,
     },
     Cost {
         variant: "Dahl update f64",
-        instructions: 2228.136,
+        instructions: 2228.17,
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 315.343,
+        instructions: 315.196,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 68.725,
+        instructions: 68.872,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 259.068,
+        instructions: 259.166,
     },
     Cost {
         variant: "Coulomb ratio f64",
-        instructions: 2720.0,
+        instructions: 2720.098,
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11353.333,
+        instructions: 11353.548,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 5869.462,
+        instructions: 5869.408,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 31789.783,
+        instructions: 31845.807,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 147229.84,
+        instructions: 147230.27,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20280.967,
+        instructions: 20281.396,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
@@ -91,35 +91,35 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 58561.184,
+        instructions: 58658.71,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 269833.72,
+        instructions: 269833.6,
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 37995.97,
+        instructions: 37995.86,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22176.021,
+        instructions: 22176.129,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 111755.914,
+        instructions: 111925.86,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 511146.5,
+        instructions: 511147.9,
     },
     Cost {
         variant: "Dahl steady T=33x33",
-        instructions: 910.483,
+        instructions: 910.752,
     },
     Cost {
         variant: "Dahl steady T=65x65",
-        instructions: 912.096,
+        instructions: 911.935,
     },
     Cost {
         variant: "cube el N=4",
@@ -127,11 +127,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
-        instructions: 378.03,
+        instructions: 377.878,
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 260.151,
+        instructions: 262.878,
     },
     Cost {
         variant: "cube el N=4 f64",
@@ -139,55 +139,55 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 830.151,
+        instructions: 829.848,
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 631.818,
+        instructions: 632.121,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
-        instructions: 388.787,
+        instructions: 393.484,
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15228.787,
+        instructions: 15228.636,
     },
     Cost {
         variant: "cube el N=16",
-        instructions: 1305.909,
+        instructions: 1305.757,
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
-        instructions: 1141.666,
+        instructions: 1141.818,
     },
     Cost {
         variant: "cube el N=16 f32 libm",
-        instructions: 646.969,
+        instructions: 657.424,
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26879.393,
+        instructions: 26878.94,
     },
     Cost {
         variant: "cube el N=32",
-        instructions: 2258.03,
+        instructions: 2257.878,
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.666,
+        instructions: 2161.515,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
-        instructions: 1163.181,
+        instructions: 1183.787,
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50123.484,
+        instructions: 50123.938,
     },
     Cost {
         variant: "cube el T=5x5",
-        instructions: 282.575,
+        instructions: 282.727,
     },
     Cost {
         variant: "cube el T=9x9",
@@ -195,35 +195,35 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el T=17x17",
-        instructions: 282.575,
+        instructions: 282.727,
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 591.666,
+        instructions: 591.969,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 377.727,
+        instructions: 378.03,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
-        instructions: 260.303,
+        instructions: 262.878,
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9414.393,
+        instructions: 9414.242,
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 830.0,
+        instructions: 830.151,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 631.818,
+        instructions: 631.969,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
-        instructions: 388.333,
+        instructions: 393.333,
     },
     Cost {
         variant: "cube ep N=8 f64",
@@ -231,7 +231,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1306.06,
+        instructions: 1305.606,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
@@ -239,11 +239,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 647.272,
+        instructions: 657.272,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26867.879,
+        instructions: 26867.424,
     },
     Cost {
         variant: "cube ep N=32",
@@ -255,23 +255,23 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
-        instructions: 1163.03,
+        instructions: 1183.484,
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50111.21,
+        instructions: 50110.91,
     },
     Cost {
         variant: "cube ep T=5x5",
-        instructions: 282.727,
+        instructions: 282.575,
     },
     Cost {
         variant: "cube ep T=9x9",
-        instructions: 282.878,
+        instructions: 282.727,
     },
     Cost {
         variant: "cube ep T=17x17",
-        instructions: 282.878,
+        instructions: 282.575,
     },
 ];
 
@@ -1173,102 +1173,102 @@ static ERRORS: &[SceneError] = &[
 static STEPS: &[StepCost] = &[
     StepCost {
         variant: "Coulomb ratio",
-        mean: 3181.28,
-        longest: 3480,
+        mean: 3241.76,
+        longest: 3560,
     },
     StepCost {
         variant: "Dahl steady N=16",
-        mean: 210205.28,
-        longest: 262120,
+        mean: 210268.16,
+        longest: 262160,
     },
     StepCost {
         variant: "Dahl steady N=32",
-        mean: 380271.03,
-        longest: 473880,
+        mean: 380327.38,
+        longest: 473920,
     },
     StepCost {
         variant: "Dahl steady N=64",
-        mean: 715220.6,
-        longest: 891280,
+        mean: 715292.6,
+        longest: 891960,
     },
     StepCost {
         variant: "Dahl steady T=33x33",
-        mean: 5453.6,
-        longest: 6320,
+        mean: 5515.84,
+        longest: 6400,
     },
     StepCost {
         variant: "Dahl steady T=65x65",
-        mean: 5593.12,
-        longest: 6480,
+        mean: 5654.56,
+        longest: 6560,
     },
     StepCost {
         variant: "cube el N=4",
-        mean: 4627.534,
-        longest: 6200,
+        mean: 4698.901,
+        longest: 6280,
     },
     StepCost {
         variant: "cube el N=8",
-        mean: 5616.461,
-        longest: 7680,
-    },
-    StepCost {
-        variant: "cube el N=16",
-        mean: 7592.712,
-        longest: 10720,
-    },
-    StepCost {
-        variant: "cube el N=32",
-        mean: 11551.843,
-        longest: 16800,
-    },
-    StepCost {
-        variant: "cube el T=5x5",
-        mean: 3657.341,
-        longest: 3760,
-    },
-    StepCost {
-        variant: "cube el T=9x9",
-        mean: 3684.08,
-        longest: 3840,
-    },
-    StepCost {
-        variant: "cube el T=17x17",
-        mean: 3694.087,
-        longest: 3880,
-    },
-    StepCost {
-        variant: "cube ep N=4",
-        mean: 4629.269,
-        longest: 6160,
-    },
-    StepCost {
-        variant: "cube ep N=8",
-        mean: 5617.261,
+        mean: 5689.338,
         longest: 7760,
     },
     StepCost {
+        variant: "cube el N=16",
+        mean: 7665.901,
+        longest: 10800,
+    },
+    StepCost {
+        variant: "cube el N=32",
+        mean: 11622.88,
+        longest: 16840,
+    },
+    StepCost {
+        variant: "cube el T=5x5",
+        mean: 3728.869,
+        longest: 3840,
+    },
+    StepCost {
+        variant: "cube el T=9x9",
+        mean: 3756.138,
+        longest: 3880,
+    },
+    StepCost {
+        variant: "cube el T=17x17",
+        mean: 3765.872,
+        longest: 3920,
+    },
+    StepCost {
+        variant: "cube ep N=4",
+        mean: 4701.367,
+        longest: 6200,
+    },
+    StepCost {
+        variant: "cube ep N=8",
+        mean: 5688.585,
+        longest: 7800,
+    },
+    StepCost {
         variant: "cube ep N=16",
-        mean: 7596.84,
+        mean: 7667.48,
         longest: 10760,
     },
     StepCost {
         variant: "cube ep N=32",
-        mean: 11551.429,
+        mean: 11626.807,
         longest: 16840,
     },
     StepCost {
         variant: "cube ep T=5x5",
-        mean: 3657.643,
-        longest: 3800,
+        mean: 3729.338,
+        longest: 3840,
     },
     StepCost {
         variant: "cube ep T=9x9",
-        mean: 3685.312,
-        longest: 3840,
+        mean: 3756.48,
+        longest: 3880,
     },
     StepCost {
         variant: "cube ep T=17x17",
-        mean: 3694.981,
-        longest: 3840,
+        mean: 3766.96,
+        longest: 3880,
     },
 ];
