@@ -344,7 +344,7 @@ impl Station {
                 // The search drives its own low amplitude; the friction loop waits (a
                 // pending `start`) or keeps its supervision while its command is replaced.
                 output.amplitude = if drive_allowed {
-                    search_command(resonance.search_amplitude())
+                    resonance.search_amplitude().command()
                 } else {
                     Q1_31::ZERO
                 };
@@ -360,7 +360,7 @@ impl Station {
                 let _ = self.controller.start();
             }
         }
-        self.applied = drive_amplitude(output.amplitude);
+        self.applied = Amplitude::from_command(output.amplitude);
         self.commission_period(
             &mut output,
             normal_force,
@@ -764,19 +764,6 @@ impl Station {
     pub fn channels_mut(&mut self) -> (&mut SensorChannel, &mut SensorChannel) {
         (&mut self.normal, &mut self.tangential)
     }
-}
-
-/// The controller's Q1.31 command for the search's amplitude (at most 1, which Q1.31 holds as
-/// its largest value).
-fn search_command(amplitude: Amplitude) -> Q1_31 {
-    let bits = i64::from(amplitude.bits()) << 1;
-    Q1_31::from_bits(bits.min(i64::from(i32::MAX)) as i32)
-}
-
-/// The drive amplitude of a controller command (Q1.31 in [0, 1) to Q2.30; negative as zero).
-fn drive_amplitude(command: Q1_31) -> Amplitude {
-    let bits = command.to_bits().max(0) >> 1;
-    Amplitude::new(Q2_30::from_bits(bits)).unwrap_or(Amplitude::ZERO)
 }
 
 /// A drive frequency in cHz as the protocol writes it (`39500.50`), for an error reply.
