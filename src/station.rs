@@ -344,7 +344,7 @@ impl Station {
                 // The search drives its own low amplitude; the friction loop waits (a
                 // pending `start`) or keeps its supervision while its command is replaced.
                 output.amplitude = if drive_allowed {
-                    search_command(resonance.search_amplitude())
+                    resonance.search_amplitude().command()
                 } else {
                     Q1_31::ZERO
                 };
@@ -360,7 +360,7 @@ impl Station {
                 let _ = self.controller.start();
             }
         }
-        self.applied = drive_amplitude(output.amplitude);
+        self.applied = Amplitude::from_command(output.amplitude);
         self.commission_period(
             &mut output,
             normal_force,
@@ -379,185 +379,232 @@ impl Station {
     /// `cal`) whole, or refuses it with the protocol error and changes nothing. `tare` and
     /// `cal` need the drive off (state `idle` or `fault`): a vibrating contact loads the cells.
     /// Other commands are not the loop's: they are refused as `wrong-state`.
+    ///
+    /// One step per command, each named for what it does to the loop; while commissioning
+    /// runs, the sequence owns the drive ([`Self::execute_while_commissioning`]).
     pub fn execute(
         &mut self,
         command: &Command,
         bench: &mut impl CellBench,
     ) -> Result<(), ProtocolError> {
-        let refused = |e: crate::control::ControlError| e.to_protocol();
         if self.commissioning() {
-            // The sequence owns the drive until it ends; `stop` ends it.
-            return match command {
-                Command::Stop => {
-                    self.cancel_commission();
-                    Ok(())
-                }
-                _ => Err(ProtocolError::WrongState {
-                    command: command.keyword(),
-                    state: SupervisorState::Tuning,
-                }),
-            };
+            return self.execute_while_commissioning(command);
         }
+        let refused = |e: crate::control::ControlError| e.to_protocol();
         match *command {
             Command::Commission => self.start_commission(command),
-            Command::Target(target) => {
-                self.controller.set_target(target).map_err(refused)?;
-                self.target_warning = self.beyond_reach(target);
-                Ok(())
-            }
-            Command::Start if self.auto_armed => {
-                // Refused for the controller's reasons (no target, fault latched) before
-                // anything changes; accepted, the search runs first and the friction loop
-                // starts at its lock.
-                let mut probe = self.controller;
-                probe.start().map_err(refused)?;
-                let resonance = self.resonance.as_mut().ok_or(ProtocolError::Unavailable {
-                    command: command.keyword(),
-                    reason: self.resonance_refused,
-                })?;
-                resonance.search().map_err(|_| ProtocolError::Unavailable {
-                    command: command.keyword(),
-                    reason: "the timer cannot make the search's frequencies",
-                })?;
-                self.auto_armed = false;
-                self.start_pending = true;
-                Ok(())
-            }
+            Command::Target(target) => self.set_target(target),
+            Command::Start if self.auto_armed => self.start_after_search(command),
             Command::Start => self.controller.start().map_err(refused),
             Command::Stop if self.start_pending => {
-                // The search stops where it is, pinned; the friction loop never started.
-                self.start_pending = false;
-                self.auto_armed = true;
-                self.pin_here();
+                self.cancel_search_before_start();
                 Ok(())
             }
             Command::Stop => self.controller.stop().map_err(refused),
-            Command::FreqAuto => {
-                if !self.current_sense {
-                    return Err(ProtocolError::Unavailable {
-                        command: command.keyword(),
-                        reason: self.no_current_reason,
-                    });
-                }
-                let resonance = self.resonance.as_mut().ok_or(ProtocolError::Unavailable {
-                    command: command.keyword(),
-                    reason: self.resonance_refused,
-                })?;
-                match self.controller.state() {
-                    crate::protocol::SupervisorState::RampUp
-                    | crate::protocol::SupervisorState::Running => {
-                        resonance.search().map_err(|_| ProtocolError::Unavailable {
-                            command: command.keyword(),
-                            reason: "the timer cannot make the search's frequencies",
-                        })?;
-                    }
-                    // Drive off: the search runs at the next `start`.
-                    _ => self.auto_armed = true,
-                }
-                Ok(())
-            }
+            Command::FreqAuto => self.track_resonance(command),
             Command::Clear => self.controller.clear_fault().map_err(refused),
-            Command::Freq { freq_chz } => {
-                if !FREQ_RANGE_CHZ.contains(&freq_chz) {
-                    // The parser never produces one; a program that builds commands may.
-                    return Err(ProtocolError::OutOfRange {
-                        token: freq_token(freq_chz),
-                        quantity: &DRIVE_FREQ,
-                    });
-                }
-                // The current rating's ceiling moves with the frequency (I = 2 pi f C V): the
-                // controller takes the new ceiling with the new frequency, or neither changes.
-                let config = self
-                    .controller
-                    .config()
-                    .at_drive_frequency(f64::from(freq_chz) / 100.0)
-                    .map_err(|_| ProtocolError::OutOfRange {
-                        token: freq_token(freq_chz),
-                        quantity: &DRIVE_FREQ,
-                    })?;
-                // Pinned on the timer's grid: the frequency reported is the one the timer
-                // makes (within 0.6 Hz of the command near 40 kHz).
-                let mut pinned = None;
-                if let Some(resonance) = self.resonance.as_mut() {
-                    let mut candidate = resonance.clone();
-                    if candidate
-                        .pin(Frequency::from_millihertz(freq_chz * 10))
-                        .is_ok()
-                    {
-                        pinned = Some(candidate);
-                    }
-                }
-                self.controller.reconfigure(config);
-                self.drive_hz = freq_chz as f32 / 100.0;
-                self.drive_freq_chz = freq_chz;
-                if let Some(pinned) = pinned {
-                    self.resonance = Some(pinned);
-                }
-                self.auto_armed = false;
-                if self.start_pending {
-                    self.start_pending = false;
-                    let _ = self.controller.start();
-                }
-                Ok(())
-            }
-            Command::Tare(axes) => {
-                self.require_drive_off(command)?;
-                let (normal, tangential) = match axes {
-                    TareAxes::One(Axis::Normal) => (true, false),
-                    TareAxes::One(Axis::Tangential) => (false, true),
-                    TareAxes::All => (true, true),
-                };
-                // Both bursts are taken before either channel changes: all or nothing.
-                let mut normal_codes = [0i32; COMMISSIONING_SAMPLES];
-                let mut tangential_codes = [0i32; COMMISSIONING_SAMPLES];
-                if normal && !bench.burst(Axis::Normal, 0.0, &mut normal_codes) {
-                    return Err(cal_failed("normal cell unreadable"));
-                }
-                if tangential && !bench.burst(Axis::Tangential, 0.0, &mut tangential_codes) {
-                    return Err(cal_failed("tangential cell unreadable"));
-                }
-                let mut new_normal = self.normal;
-                let mut new_tangential = self.tangential;
-                if normal {
-                    new_normal
-                        .tare(&normal_codes)
-                        .map_err(|_| cal_failed("normal zero unusable"))?;
-                }
-                if tangential {
-                    new_tangential
-                        .tare(&tangential_codes)
-                        .map_err(|_| cal_failed("tangential zero unusable"))?;
-                }
-                self.normal = new_normal;
-                self.tangential = new_tangential;
-                self.tune_to_cells()
-                    .map_err(|_| cal_failed("measured noise unusable for the tuning"))
-            }
-            Command::Cal { axis, load_mn } => {
-                self.require_drive_off(command)?;
-                let load_n = load_mn as f64 / 1e3;
-                let load = Q16_16::from_f64(load_n)
-                    .map_err(|_| cal_failed("load beyond the Q16.16 span"))?;
-                let mut codes = [0i32; COMMISSIONING_SAMPLES];
-                if !bench.burst(axis, load_n as f32, &mut codes) {
-                    return Err(cal_failed("cell unreadable"));
-                }
-                let channel = match axis {
-                    Axis::Normal => &mut self.normal,
-                    Axis::Tangential => &mut self.tangential,
-                };
-                let mut updated = *channel;
-                updated
-                    .calibrate_gain(&codes, load)
-                    .map_err(|_| cal_failed("reading moved too little"))?;
-                *channel = updated;
-                Ok(())
-            }
+            Command::Freq { freq_chz } => self.pin_drive_frequency(freq_chz),
+            Command::Tare(axes) => self.tare(command, axes, bench),
+            Command::Cal { axis, load_mn } => self.calibrate(command, axis, load_mn, bench),
             _ => Err(ProtocolError::WrongState {
                 command: command.keyword(),
                 state: self.state(),
             }),
         }
+    }
+
+    /// While commissioning runs, the sequence owns the drive until it ends: `stop` ends it,
+    /// every other command is refused in state `tuning`.
+    fn execute_while_commissioning(&mut self, command: &Command) -> Result<(), ProtocolError> {
+        match command {
+            Command::Stop => {
+                self.cancel_commission();
+                Ok(())
+            }
+            _ => Err(ProtocolError::WrongState {
+                command: command.keyword(),
+                state: SupervisorState::Tuning,
+            }),
+        }
+    }
+
+    /// `target`: the controller's new set point, and whether the full drive reaches it now
+    /// (the reply's `warning=beyond-reach`).
+    fn set_target(&mut self, target: crate::protocol::Target) -> Result<(), ProtocolError> {
+        self.controller
+            .set_target(target)
+            .map_err(|e| e.to_protocol())?;
+        self.target_warning = self.beyond_reach(target);
+        Ok(())
+    }
+
+    /// `start` after `freq auto` given with the drive off: refused for the controller's
+    /// reasons (no target, fault latched) before anything changes; accepted, the search runs
+    /// first and the friction loop starts at its lock ([`Self::control`]).
+    fn start_after_search(&mut self, command: &Command) -> Result<(), ProtocolError> {
+        let mut probe = self.controller;
+        probe.start().map_err(|e| e.to_protocol())?;
+        let resonance = self.resonance.as_mut().ok_or(ProtocolError::Unavailable {
+            command: command.keyword(),
+            reason: self.resonance_refused,
+        })?;
+        resonance.search().map_err(|_| ProtocolError::Unavailable {
+            command: command.keyword(),
+            reason: "the timer cannot make the search's frequencies",
+        })?;
+        self.auto_armed = false;
+        self.start_pending = true;
+        Ok(())
+    }
+
+    /// `stop` while a `start` waits for the search: the search stops where it is, pinned; the
+    /// friction loop never started, and the next `start` searches again.
+    fn cancel_search_before_start(&mut self) {
+        self.start_pending = false;
+        self.auto_armed = true;
+        self.pin_here();
+    }
+
+    /// `freq auto`: the resonance loop searches now with the drive on, or at the next `start`
+    /// with it off. Refused where the board or the scene gives no current samples, or the
+    /// stack has no loop.
+    fn track_resonance(&mut self, command: &Command) -> Result<(), ProtocolError> {
+        if !self.current_sense {
+            return Err(ProtocolError::Unavailable {
+                command: command.keyword(),
+                reason: self.no_current_reason,
+            });
+        }
+        let resonance = self.resonance.as_mut().ok_or(ProtocolError::Unavailable {
+            command: command.keyword(),
+            reason: self.resonance_refused,
+        })?;
+        match self.controller.state() {
+            SupervisorState::RampUp | SupervisorState::Running => {
+                resonance.search().map_err(|_| ProtocolError::Unavailable {
+                    command: command.keyword(),
+                    reason: "the timer cannot make the search's frequencies",
+                })?;
+            }
+            // Drive off: the search runs at the next `start`.
+            _ => self.auto_armed = true,
+        }
+        Ok(())
+    }
+
+    /// `freq HZ`: the drive pinned at `freq_chz`, with the current rating's ceiling there.
+    fn pin_drive_frequency(&mut self, freq_chz: u32) -> Result<(), ProtocolError> {
+        if !FREQ_RANGE_CHZ.contains(&freq_chz) {
+            // The parser never produces one; a program that builds commands may.
+            return Err(ProtocolError::OutOfRange {
+                token: freq_token(freq_chz),
+                quantity: &DRIVE_FREQ,
+            });
+        }
+        // The current rating's ceiling moves with the frequency (I = 2 pi f C V): the
+        // controller takes the new ceiling with the new frequency, or neither changes.
+        let config = self
+            .controller
+            .config()
+            .at_drive_frequency(f64::from(freq_chz) / 100.0)
+            .map_err(|_| ProtocolError::OutOfRange {
+                token: freq_token(freq_chz),
+                quantity: &DRIVE_FREQ,
+            })?;
+        // Pinned on the timer's grid: the frequency reported is the one the timer
+        // makes (within 0.6 Hz of the command near 40 kHz).
+        let mut pinned = None;
+        if let Some(resonance) = self.resonance.as_mut() {
+            let mut candidate = resonance.clone();
+            if candidate
+                .pin(Frequency::from_millihertz(freq_chz * 10))
+                .is_ok()
+            {
+                pinned = Some(candidate);
+            }
+        }
+        self.controller.reconfigure(config);
+        self.drive_hz = freq_chz as f32 / 100.0;
+        self.drive_freq_chz = freq_chz;
+        if let Some(pinned) = pinned {
+            self.resonance = Some(pinned);
+        }
+        self.auto_armed = false;
+        if self.start_pending {
+            self.start_pending = false;
+            let _ = self.controller.start();
+        }
+        Ok(())
+    }
+
+    /// `tare`: the zero of one cell or both from a burst each, with the drive off; the gains
+    /// retuned to the noise the bursts measured. Both bursts are taken before either channel
+    /// changes: all or nothing.
+    fn tare(
+        &mut self,
+        command: &Command,
+        axes: TareAxes,
+        bench: &mut impl CellBench,
+    ) -> Result<(), ProtocolError> {
+        self.require_drive_off(command)?;
+        let (normal, tangential) = match axes {
+            TareAxes::One(Axis::Normal) => (true, false),
+            TareAxes::One(Axis::Tangential) => (false, true),
+            TareAxes::All => (true, true),
+        };
+        let mut normal_codes = [0i32; COMMISSIONING_SAMPLES];
+        let mut tangential_codes = [0i32; COMMISSIONING_SAMPLES];
+        if normal && !bench.burst(Axis::Normal, 0.0, &mut normal_codes) {
+            return Err(cal_failed("normal cell unreadable"));
+        }
+        if tangential && !bench.burst(Axis::Tangential, 0.0, &mut tangential_codes) {
+            return Err(cal_failed("tangential cell unreadable"));
+        }
+        let mut new_normal = self.normal;
+        let mut new_tangential = self.tangential;
+        if normal {
+            new_normal
+                .tare(&normal_codes)
+                .map_err(|_| cal_failed("normal zero unusable"))?;
+        }
+        if tangential {
+            new_tangential
+                .tare(&tangential_codes)
+                .map_err(|_| cal_failed("tangential zero unusable"))?;
+        }
+        self.normal = new_normal;
+        self.tangential = new_tangential;
+        self.tune_to_cells()
+            .map_err(|_| cal_failed("measured noise unusable for the tuning"))
+    }
+
+    /// `cal`: the gain of `axis`'s cell from a burst under the known load `load_mn` (mN),
+    /// with the drive off.
+    fn calibrate(
+        &mut self,
+        command: &Command,
+        axis: Axis,
+        load_mn: u32,
+        bench: &mut impl CellBench,
+    ) -> Result<(), ProtocolError> {
+        self.require_drive_off(command)?;
+        let load_n = load_mn as f64 / 1e3;
+        let load =
+            Q16_16::from_f64(load_n).map_err(|_| cal_failed("load beyond the Q16.16 span"))?;
+        let mut codes = [0i32; COMMISSIONING_SAMPLES];
+        if !bench.burst(axis, load_n as f32, &mut codes) {
+            return Err(cal_failed("cell unreadable"));
+        }
+        let channel = match axis {
+            Axis::Normal => &mut self.normal,
+            Axis::Tangential => &mut self.tangential,
+        };
+        let mut updated = *channel;
+        updated
+            .calibrate_gain(&codes, load)
+            .map_err(|_| cal_failed("reading moved too little"))?;
+        *channel = updated;
+        Ok(())
     }
 
     /// Pins the resonance loop at its present frequency (a cancelled search).
@@ -717,19 +764,6 @@ impl Station {
     pub fn channels_mut(&mut self) -> (&mut SensorChannel, &mut SensorChannel) {
         (&mut self.normal, &mut self.tangential)
     }
-}
-
-/// The controller's Q1.31 command for the search's amplitude (at most 1, which Q1.31 holds as
-/// its largest value).
-fn search_command(amplitude: Amplitude) -> Q1_31 {
-    let bits = i64::from(amplitude.bits()) << 1;
-    Q1_31::from_bits(bits.min(i64::from(i32::MAX)) as i32)
-}
-
-/// The drive amplitude of a controller command (Q1.31 in [0, 1) to Q2.30; negative as zero).
-fn drive_amplitude(command: Q1_31) -> Amplitude {
-    let bits = command.to_bits().max(0) >> 1;
-    Amplitude::new(Q2_30::from_bits(bits)).unwrap_or(Amplitude::ZERO)
 }
 
 /// A drive frequency in cHz as the protocol writes it (`39500.50`), for an error reply.

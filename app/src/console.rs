@@ -8,6 +8,11 @@
 //! or refuses them between two steps ([`crate::link`]). The console never blocks the control
 //! loop: it runs at a lower priority, and a slow UART only fills the telemetry queue, whose
 //! overflow is counted in [`link::LOST`].
+//!
+//! A loop command whose work does not fit in a control step (a `scene NAME` load: building
+//! the loop, its feasibility check, the selection line) is prepared here first, by the board's
+//! [`Prepare`], at the console's priority where the control task preempts it; the control task
+//! then only takes the prepared result at a step boundary.
 
 use embassy_futures::select::{Either, select};
 use embassy_futures::yield_now;
@@ -39,10 +44,50 @@ pub struct Identity {
     pub scenes: &'static [&'static str],
 }
 
+/// The board's share of a loop command that is prepared out of the control step.
+///
+/// For every loop command the console calls [`Prepare::prepare`] before it queues the command
+/// for the control task, and [`Prepare::answered`] with the control task's answer. What
+/// `prepare` does runs in the console's task: the control task preempts it, so it costs no
+/// control step. The control task's [`crate::control::ControlLoop::execute`] then takes what
+/// was prepared, which must be cheap (a swap of references, not a copy of the loop).
+pub trait Prepare {
+    /// Prepares `command`; an error is the command's reply, and the command does not go to
+    /// the control task. By default nothing is prepared.
+    fn prepare(&mut self, command: &Command) -> Result<(), ProtocolError> {
+        let _ = command;
+        Ok(())
+    }
+
+    /// The control task's answer to `command`, which [`Prepare::prepare`] accepted: what was
+    /// prepared and not taken is reclaimed here, and what is reported after a change (the
+    /// selection line of a new scene) is logged here, out of the control step.
+    fn answered(&mut self, command: &Command, result: &Result<(), ProtocolError>) {
+        let _ = (command, result);
+    }
+}
+
+/// A board that prepares nothing: every loop command is the control task's alone.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NothingToPrepare;
+
+impl Prepare for NothingToPrepare {}
+
 /// Serves the console on `rx` / `tx` forever, from the moment [`link::BOOTED`] is signalled.
 /// A read error (framing, overrun) discards the
 /// partial line, whose remainder then gets its own `err` reply if it is not a command.
-pub async fn serve<R: Read, W: Write>(mut rx: R, mut tx: W, identity: &Identity) -> ! {
+pub async fn serve<R: Read, W: Write>(rx: R, tx: W, identity: &Identity) -> ! {
+    serve_preparing(rx, tx, identity, &mut NothingToPrepare).await
+}
+
+/// [`serve`], with the board's `prepare` doing the work of loop commands that does not fit in a
+/// control step ([`Prepare`]).
+pub async fn serve_preparing<R: Read, W: Write>(
+    mut rx: R,
+    mut tx: W,
+    identity: &Identity,
+    prepare: &mut impl Prepare,
+) -> ! {
     link::BOOTED.wait().await;
     let mut assembler = LineAssembler::new();
     let mut received = [0u8; 64];
@@ -72,7 +117,7 @@ pub async fn serve<R: Read, W: Write>(mut rx: R, mut tx: W, identity: &Identity)
             rest = rest.get(used..).unwrap_or(&[]);
             let Some(line) = line else { continue };
             let replied = match line.and_then(parse_command) {
-                Ok(command) => execute(&command, identity, &mut out).await,
+                Ok(command) => execute(&command, identity, prepare, &mut out).await,
                 Err(ProtocolError::EmptyLine) => false,
                 Err(error) => format_error(&error, out.as_mut_view()).is_ok(),
             };
@@ -92,7 +137,12 @@ async fn write_line<W: Write>(tx: &mut W, line: &str) {
 
 /// Executes `command` and writes its reply into `out`; false when no reply could be made (a
 /// reply that does not fit, which the protocol's sizes rule out).
-async fn execute(command: &Command, identity: &Identity, out: &mut String<LINE_CAPACITY>) -> bool {
+async fn execute(
+    command: &Command,
+    identity: &Identity,
+    prepare: &mut impl Prepare,
+    out: &mut String<LINE_CAPACITY>,
+) -> bool {
     let view = out.as_mut_view();
     let written = match *command {
         Command::Version => format_version(
@@ -138,8 +188,13 @@ async fn execute(command: &Command, identity: &Identity, out: &mut String<LINE_C
             format_ack(command, view)
         }
         _ => {
+            if let Err(error) = prepare.prepare(command) {
+                return format_error(&error, view).is_ok();
+            }
             REQUESTS.send(*command).await;
-            match RESPONSES.receive().await {
+            let result = RESPONSES.receive().await;
+            prepare.answered(command, &result);
+            match result {
                 Ok(()) if crate::persist::has_reply(command) => {
                     crate::persist::take_reply(out);
                     return !out.is_empty();

@@ -1,6 +1,7 @@
 //! The friction controller: estimate, supervisor, feedforward, PI correction and drive
 //! shaping in one step (the design and its tuning are in the `control` module docs).
 
+use super::SampleBlock;
 use super::config::Config;
 use super::error::ControlError;
 use super::estimate::{FrictionEstimate, FrictionEstimator, MIN_NATURAL_COEF, NaturalFriction};
@@ -10,7 +11,7 @@ use super::pi::{Clamp, Pi, PiGains};
 use super::reason::{ExternalFault, Reason, Sensor, SensorFault, SensorFaultKind};
 use super::recip::Reciprocal;
 use super::schedule::{Boost, GainSchedule};
-use super::shaper::DriveShaper;
+use super::shaper::{DriveRequest, DriveShaper};
 use super::sliding::SlidingDetector;
 use super::supervisor::{Contact, Supervisor};
 use super::target::PreparedTarget;
@@ -266,7 +267,7 @@ impl Controller {
             inputs.sliding_velocity,
         );
         s.contact = match (
-            s.sliding.update(&c.sliding, inputs.sliding_velocity),
+            c.sliding.process(&mut s.sliding, inputs.sliding_velocity),
             s.estimate.load_ok,
         ) {
             (false, _) => Contact::NotSliding,
@@ -360,21 +361,20 @@ impl Controller {
                 s.prediction_valid = true;
             }
             let predicted_now = match &c.contact_lag {
-                Some(lag) => s.contact_prediction.update(lag, predicted_now),
+                Some(lag) => lag.process(&mut s.contact_prediction, predicted_now),
                 None => predicted_now,
             };
             let sensed = match &c.sensor_lag {
-                Some(lag) => s.sensed_prediction.update(lag, predicted_now),
+                Some(lag) => lag.process(&mut s.sensed_prediction, predicted_now),
                 None => predicted_now,
             };
-            let predicted = s.prediction.update(&c.estimator.tangential, sensed);
+            let predicted = c.estimator.tangential.process(&mut s.prediction, sensed);
             let reference = predicted.saturating_sub(s.pi.correction()).value;
             let error = reference.saturating_sub(measured).value;
             // This step's gains on the schedule; the change from the last step is bumpless.
-            let gains = c.gains.gains(s.boost.weight());
+            let gains = c.gains.process(&mut s.boost, ());
             s.pi.retune(&s.gains, &gains);
             s.gains = gains;
-            s.boost.advance(&c.gains);
             let candidate = s.pi.candidate(&gains, error);
             let command = target_ratio
                 .value
@@ -403,7 +403,9 @@ impl Controller {
             report.saturation.integral_frozen = s.pi.frozen();
             desired
         };
-        let shaped = s.shaper.drive(&c.shaper, desired, ceiling);
+        let shaped = c
+            .shaper
+            .process(&mut s.shaper, DriveRequest { desired, ceiling });
         report.saturation.slew = shaped.slew_limited;
         report.saturation.soft_start = ramping && shaped.ceiling_limited;
         s.supervisor

@@ -18,6 +18,7 @@
 
 use core::num::NonZeroU32;
 
+use super::SampleBlock;
 use super::filter::{LowPass, LowPassCoef};
 use super::recip::Reciprocal;
 use crate::fx::{Q2_30, Q8_24, Q16_16};
@@ -95,9 +96,13 @@ impl FrictionEstimator {
             self.velocity.reset(sliding_velocity);
             self.primed = true;
         }
-        let normal = self.normal.update(&config.normal, normal_force);
-        let tangential = self.tangential.update(&config.tangential, tangential_force);
-        let velocity = self.velocity.update(&config.velocity, sliding_velocity);
+        let normal = config.normal.process(&mut self.normal, normal_force);
+        let tangential = config
+            .tangential
+            .process(&mut self.tangential, tangential_force);
+        let velocity = config
+            .velocity
+            .process(&mut self.velocity, sliding_velocity);
         let load_ok = normal >= config.min_normal_force;
         let guarded = if load_ok {
             normal

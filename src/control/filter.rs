@@ -17,6 +17,7 @@
 //! old state and the input: no overflow at full-scale inputs of either sign. About 20
 //! instructions per sample on the Cortex-M4.
 
+use super::SampleBlock;
 use crate::fx::{Q, Q1_31};
 
 /// Why a filter coefficient could not be made.
@@ -116,23 +117,29 @@ impl<const F: u32> LowPass<F> {
         *self = Self::new(value);
     }
 
-    /// Takes one input sample and returns the new output. Never overflows, never panics.
-    pub fn update(&mut self, coef: &LowPassCoef, input: Q<F>) -> Q<F> {
-        let alpha = coef.alpha.to_bits() as i64; // (0, 2^31)
-        // |input << 31| <= 2^62 and the state lies between past inputs: |diff| < 2^63.
-        let diff = ((input.to_bits() as i64) << 31) - self.state;
-        let high = diff >> 31; // [-2^32, 2^32)
-        let low = diff & 0x7FFF_FFFF; // [0, 2^31)
-        // alpha (high 2^31 + low) / 2^31, the low part rounded to nearest; |alpha high| < 2^63.
-        let step = alpha * high + ((alpha * low + (1 << 30)) >> 31);
-        self.state += step;
-        self.output()
-    }
-
     /// The present output, rounded to nearest from the wide state.
     pub const fn output(&self) -> Q<F> {
         // state <= (2^31 - 1) 2^31, so the rounded value fits i32.
         Q::<F>::from_bits(((self.state + (1 << 30)) >> 31) as i32)
+    }
+}
+
+/// The filter: one input sample of format `Q<F>` into the state, the new output out. Never
+/// overflows, never panics.
+impl<const F: u32> SampleBlock<Q<F>> for LowPassCoef {
+    type State = LowPass<F>;
+    type Output = Q<F>;
+
+    fn process(&self, filter: &mut LowPass<F>, input: Q<F>) -> Q<F> {
+        let alpha = self.alpha.to_bits() as i64; // (0, 2^31)
+        // |input << 31| <= 2^62 and the state lies between past inputs: |diff| < 2^63.
+        let diff = ((input.to_bits() as i64) << 31) - filter.state;
+        let high = diff >> 31; // [-2^32, 2^32)
+        let low = diff & 0x7FFF_FFFF; // [0, 2^31)
+        // alpha (high 2^31 + low) / 2^31, the low part rounded to nearest; |alpha high| < 2^63.
+        let step = alpha * high + ((alpha * low + (1 << 30)) >> 31);
+        filter.state += step;
+        filter.output()
     }
 }
 
@@ -156,7 +163,7 @@ mod tests {
         for n in 0..total {
             let phase = core::f64::consts::TAU * freq_hz * n as f64 / FS;
             let x = Q16_16::from_f64(amplitude * phase.sin()).unwrap();
-            let y = filter.update(coef, x).to_f64();
+            let y = coef.process(&mut filter, x).to_f64();
             if n >= settle {
                 i_sum += y * phase.sin();
                 q_sum += y * phase.cos();
@@ -201,7 +208,7 @@ mod tests {
                 let input = Q2_30::from_bits(level);
                 // 1 Hz at 10 kHz: time constant 1592 samples; 60k samples is 37 of them.
                 for _ in 0..60_000 {
-                    filter.update(&coef, input);
+                    coef.process(&mut filter, input);
                 }
                 assert_eq!(filter.output(), input, "from {start} to {level}");
             }
@@ -215,7 +222,7 @@ mod tests {
         let mut filter = LowPass::<31>::new(Q1_31::ZERO);
         let step = Q1_31::from_f64(0.5).unwrap();
         for n in 1..=40 {
-            let y = filter.update(&coef, step).to_f64();
+            let y = coef.process(&mut filter, step).to_f64();
             let exact = 0.5 * (1.0 - (-(n as f64) / (FS * tau)).exp());
             assert!((y - exact).abs() < 1e-8, "sample {n}: {y} vs {exact}");
         }
@@ -264,7 +271,7 @@ mod tests {
             for x in inputs {
                 low = low.min(x);
                 high = high.max(x);
-                let y = filter.update(&coef, Q16_16::from_bits(x)).to_bits();
+                let y = coef.process(&mut filter, Q16_16::from_bits(x)).to_bits();
                 prop_assert!(low <= y && y <= high, "{y} outside [{low}, {high}]");
             }
         }

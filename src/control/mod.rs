@@ -114,6 +114,7 @@
 //! Cortex-M4, with the commands that measure them: `docs/control-and-scenes.md`, "The
 //! controller on the test plant".
 
+mod block;
 mod config;
 mod controller;
 mod error;
@@ -144,6 +145,7 @@ mod property_tests;
 #[cfg(test)]
 mod testkit;
 
+pub use block::SampleBlock;
 pub use config::{Config, ConfigError, SensorRanges, Settings, gain_schedule};
 pub use controller::{Controller, ControllerState};
 pub use error::ControlError;
@@ -159,7 +161,7 @@ pub use pi::{Clamp, GainsError, Pi, PiCandidate, PiGains};
 pub use reason::{ExternalFault, Reason, Sensor, SensorFault, SensorFaultKind};
 pub use recip::Reciprocal;
 pub use schedule::{Boost, GainSchedule};
-pub use shaper::{DriveShaper, Shaped, ShaperConfig, ShaperError};
+pub use shaper::{DriveRequest, DriveShaper, Shaped, ShaperConfig, ShaperError};
 pub use sliding::{SlidingConfig, SlidingDetector};
 pub use supervisor::{Contact, RampConfig, Supervisor};
 pub use target::{ForceQ, PreparedTarget};

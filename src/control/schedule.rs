@@ -18,6 +18,7 @@
 //! `K_fast` and the `slow` floor. The gains change a little every step;
 //! [`super::pi::Pi::retune`] keeps each change bumpless.
 
+use super::SampleBlock;
 use super::pi::{GainsError, PiGains};
 use crate::fx::Q2_30;
 
@@ -116,24 +117,32 @@ impl Boost {
         self.held = 0;
     }
 
-    /// One step: held, then `w <- w - (K_fast T) w^2`. The decrement is rounded up (at least
-    /// one lsb while `w > 0`), so that the weight reaches exactly zero (rounding to nearest
-    /// would stop it where `s w^2` rounds to nothing).
-    pub fn advance(&mut self, schedule: &GainSchedule) {
-        if self.held < schedule.hold_steps {
-            self.held += 1;
-            return;
-        }
-        // w and s in [0, 2^30]: w^2 < 2^61 and (w^2 >> 30) s < 2^61, both fit i64.
-        let w = self.weight.to_bits() as i64;
-        let square = (w * w + (1 << 30) - 1) >> 30;
-        let decrement = (square * schedule.shrink.to_bits() as i64 + (1 << 30) - 1) >> 30;
-        self.weight = Q2_30::from_bits((w - decrement.max(i64::from(w > 0))).max(0) as i32);
-    }
-
     /// The weight, Q2.30 in [0, 1].
     pub const fn weight(&self) -> Q2_30 {
         self.weight
+    }
+}
+
+/// The schedule: one step (no input) gives this step's gains, at the boost's weight, and
+/// advances the boost: held for the schedule's hold, then `w <- w - (K_fast T) w^2`. The
+/// decrement is rounded up (at least one lsb while `w > 0`), so that the weight reaches
+/// exactly zero (rounding to nearest would stop it where `s w^2` rounds to nothing).
+impl SampleBlock<()> for GainSchedule {
+    type State = Boost;
+    type Output = PiGains;
+
+    fn process(&self, boost: &mut Boost, (): ()) -> PiGains {
+        let gains = self.gains(boost.weight);
+        if boost.held < self.hold_steps {
+            boost.held += 1;
+            return gains;
+        }
+        // w and s in [0, 2^30]: w^2 < 2^61 and (w^2 >> 30) s < 2^61, both fit i64.
+        let w = boost.weight.to_bits() as i64;
+        let square = (w * w + (1 << 30) - 1) >> 30;
+        let decrement = (square * self.shrink.to_bits() as i64 + (1 << 30) - 1) >> 30;
+        boost.weight = Q2_30::from_bits((w - decrement.max(i64::from(w > 0))).max(0) as i32);
+        gains
     }
 }
 
@@ -152,11 +161,11 @@ mod tests {
         boost.restart();
         for _ in 0..10 {
             assert_eq!(schedule.gains(boost.weight()), fast);
-            boost.advance(&schedule);
+            schedule.process(&mut boost, ());
         }
         assert_eq!(schedule.gains(boost.weight()), fast);
         for _ in 0..100 {
-            boost.advance(&schedule);
+            schedule.process(&mut boost, ());
         }
         // 10 ms after the hold: w = 1 / (1 + K_fast t) = 1 / 31 by the continuous law; the
         // one-step recurrence of w' = -K w^2 with K T = 0.3 runs a little slower (it sums
@@ -171,7 +180,7 @@ mod tests {
         // The hyperbola reaches 2^-15 after about 1 / (K T 2^-15) = 110 000 steps, then one lsb
         // a step to zero.
         for _ in 0..200_000 {
-            boost.advance(&schedule);
+            schedule.process(&mut boost, ());
         }
         assert_eq!(boost.weight(), Q2_30::ZERO);
         assert_eq!(schedule.gains(boost.weight()), slow);

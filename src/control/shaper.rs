@@ -16,6 +16,7 @@
 //! the floor 0. The ceiling comes last because it is a rating: it is never exceeded, even if
 //! that means a step larger than the slew limit.
 
+use super::SampleBlock;
 use super::filter::{FilterError, LowPass, LowPassCoef};
 use crate::fx::{Q1_31, Q8_24};
 
@@ -114,34 +115,12 @@ impl DriveShaper {
         }
     }
 
-    /// Shapes the `desired` amplitude into this step's command under `ceiling` (both Q1.31
-    /// in [0, 1)) and advances the envelope estimate with it.
-    pub fn drive(&mut self, config: &ShaperConfig, desired: Q1_31, ceiling: Q1_31) -> Shaped {
-        let envelope = self.envelope.output().to_bits() as i64;
-        // (desired - envelope) in (-2^31, 2^31) times g < 2^31: below 2^62.
-        let push = (desired.to_bits() as i64 - envelope) * config.lead_gain.to_bits() as i64;
-        let lead = envelope + ((push + (1 << 23)) >> 24);
-        let previous = self.command.to_bits() as i64;
-        let step = config.slew_step.to_bits() as i64;
-        // max/min, not clamp: no panic path in the binary.
-        let slewed = lead.min(previous + step).max(previous - step);
-        let ceiling_bits = ceiling.to_bits().max(0) as i64;
-        let bounded = slewed.min(ceiling_bits).max(0);
-        let shaped = Shaped {
-            amplitude: Q1_31::from_bits(bounded as i32), // in [0, ceiling]
-            slew_limited: slewed != lead,
-            ceiling_limited: slewed > ceiling_bits,
-        };
-        self.apply(config, shaped.amplitude);
-        shaped
-    }
-
     /// Applies `amplitude` as it is (ramp-down, drive off, fault: no lead, no slew) and
     /// advances the envelope estimate with it. Negative values are taken as zero.
     pub fn apply(&mut self, config: &ShaperConfig, amplitude: Q1_31) {
         self.command = amplitude.max(Q1_31::ZERO);
         self.before = self.envelope;
-        self.envelope.update(&config.envelope, self.command);
+        config.envelope.process(&mut self.envelope, self.command);
     }
 
     /// Replaces the last command by `amplitude`, the drive actually applied over that step
@@ -161,6 +140,44 @@ impl DriveShaper {
     /// fraction of full scale in [0, 1). Exactly zero once the drive has been off long enough.
     pub const fn envelope(&self) -> Q1_31 {
         self.envelope.output()
+    }
+}
+
+/// One step's request to the shaper: the amplitude the loop wants and the ceiling it may not
+/// pass, both Q1.31 fractions of full scale in [0, 1) (a negative ceiling counts as zero).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DriveRequest {
+    /// The amplitude the loop wants.
+    pub desired: Q1_31,
+    /// The ceiling of this step (the limit, or the soft start's ramp).
+    pub ceiling: Q1_31,
+}
+
+/// The shaper: one step's request through the lead, the slew limit and the ceiling into this
+/// step's command, which also advances the envelope estimate.
+impl SampleBlock<DriveRequest> for ShaperConfig {
+    type State = DriveShaper;
+    type Output = Shaped;
+
+    fn process(&self, shaper: &mut DriveShaper, request: DriveRequest) -> Shaped {
+        let envelope = shaper.envelope.output().to_bits() as i64;
+        // (desired - envelope) in (-2^31, 2^31) times g < 2^31: below 2^62.
+        let push = (request.desired.to_bits() as i64 - envelope) * self.lead_gain.to_bits() as i64;
+        let lead = envelope + ((push + (1 << 23)) >> 24);
+        let previous = shaper.command.to_bits() as i64;
+        let step = self.slew_step.to_bits() as i64;
+        // max/min, not clamp: no panic path in the binary.
+        let slewed = lead.min(previous + step).max(previous - step);
+        let ceiling_bits = request.ceiling.to_bits().max(0) as i64;
+        let bounded = slewed.min(ceiling_bits).max(0);
+        let shaped = Shaped {
+            amplitude: Q1_31::from_bits(bounded as i32), // in [0, ceiling]
+            slew_limited: slewed != lead,
+            ceiling_limited: slewed > ceiling_bits,
+        };
+        shaper.apply(self, shaped.amplitude);
+        shaped
     }
 }
 
@@ -190,7 +207,13 @@ mod tests {
         let mut true_envelope = 0.0f64;
         let alpha_env = 1.0 - (-T / 0.8e-3f64).exp();
         for n in 1..=30 {
-            let shaped = shaper.drive(&cfg, a(0.3), Q1_31::MAX);
+            let shaped = cfg.process(
+                &mut shaper,
+                DriveRequest {
+                    desired: a(0.3),
+                    ceiling: Q1_31::MAX,
+                },
+            );
             true_envelope += alpha_env * (shaped.amplitude.to_f64() - true_envelope);
             let want = 0.3 * (1.0 - (-(n as f64) * T / 0.25e-3).exp());
             assert!(
@@ -208,7 +231,13 @@ mod tests {
         let mut applied = DriveShaper::new();
         for k in 0..30 {
             let search = a(if k < 20 { 0.1 } else { 0.0 });
-            told.drive(&config, a(0.6), a(0.9));
+            config.process(
+                &mut told,
+                DriveRequest {
+                    desired: a(0.6),
+                    ceiling: a(0.9),
+                },
+            );
             told.replace(&config, search);
             applied.apply(&config, search);
             assert_eq!(told, applied, "step {k}");
@@ -220,15 +249,39 @@ mod tests {
     fn slew_and_ceiling_limit_the_command() {
         let cfg = ShaperConfig::new(0.8e-3, 0.25e-3, 0.5e-3, T).unwrap(); // 0.2 per step
         let mut shaper = DriveShaper::new();
-        let s = shaper.drive(&cfg, a(0.9), a(0.5));
+        let s = cfg.process(
+            &mut shaper,
+            DriveRequest {
+                desired: a(0.9),
+                ceiling: a(0.5),
+            },
+        );
         assert!(s.slew_limited && !s.ceiling_limited);
         assert!((s.amplitude.to_f64() - 0.2).abs() < 1e-9);
-        let s = shaper.drive(&cfg, a(0.9), a(0.5));
+        let s = cfg.process(
+            &mut shaper,
+            DriveRequest {
+                desired: a(0.9),
+                ceiling: a(0.5),
+            },
+        );
         assert!((s.amplitude.to_f64() - 0.4).abs() < 1e-9);
-        let s = shaper.drive(&cfg, a(0.9), a(0.5));
+        let s = cfg.process(
+            &mut shaper,
+            DriveRequest {
+                desired: a(0.9),
+                ceiling: a(0.5),
+            },
+        );
         assert!(s.ceiling_limited && s.amplitude == a(0.5));
         // A ceiling dropped below the command applies at once, beyond the slew limit.
-        let s = shaper.drive(&cfg, a(0.9), a(0.1));
+        let s = cfg.process(
+            &mut shaper,
+            DriveRequest {
+                desired: a(0.9),
+                ceiling: a(0.1),
+            },
+        );
         assert_eq!(s.amplitude, a(0.1));
         // Drive off: the envelope estimate decays to exactly zero.
         for _ in 0..2_000 {
@@ -255,7 +308,7 @@ mod tests {
             let cfg = ShaperConfig::new(0.8e-3, 0.1e-3, 0.2e-3, T).unwrap();
             let mut shaper = DriveShaper::new();
             for (desired, ceiling) in steps {
-                let s = shaper.drive(&cfg, Q1_31::from_bits(desired), Q1_31::from_bits(ceiling));
+                let s = cfg.process(&mut shaper, DriveRequest { desired: Q1_31::from_bits(desired), ceiling: Q1_31::from_bits(ceiling) });
                 prop_assert!(!s.amplitude.is_negative());
                 prop_assert!(s.amplitude.to_bits() <= ceiling.max(0));
                 prop_assert!(!shaper.envelope().is_negative());

@@ -7,6 +7,7 @@
 //! velocity noise near a threshold or a glitch of one sample does not toggle the loop. It uses
 //! the unfiltered velocity: the debounce is the filter, and its delay is exactly stated.
 
+use super::SampleBlock;
 use crate::fx::Q8_24;
 
 /// Configuration of the sliding detector.
@@ -38,29 +39,35 @@ impl SlidingDetector {
         }
     }
 
-    /// Takes one velocity sample (any bits, signed) and returns whether the contact slides.
-    pub fn update(&mut self, config: &SlidingConfig, velocity: Q8_24) -> bool {
-        let speed = velocity.saturating_abs().value;
-        let wants_change = if self.sliding {
-            speed < config.off
-        } else {
-            speed > config.on
-        };
-        if wants_change {
-            self.pending = self.pending.saturating_add(1);
-            if self.pending >= config.debounce_steps {
-                self.sliding = !self.sliding;
-                self.pending = 0;
-            }
-        } else {
-            self.pending = 0;
-        }
-        self.sliding
-    }
-
     /// Whether the contact slides (as of the last update).
     pub const fn is_sliding(&self) -> bool {
         self.sliding
+    }
+}
+
+/// The detector: one velocity sample (any bits, signed) into the state; whether the contact
+/// slides out.
+impl SampleBlock<Q8_24> for SlidingConfig {
+    type State = SlidingDetector;
+    type Output = bool;
+
+    fn process(&self, detector: &mut SlidingDetector, velocity: Q8_24) -> bool {
+        let speed = velocity.saturating_abs().value;
+        let wants_change = if detector.sliding {
+            speed < self.off
+        } else {
+            speed > self.on
+        };
+        if wants_change {
+            detector.pending = detector.pending.saturating_add(1);
+            if detector.pending >= self.debounce_steps {
+                detector.sliding = !detector.sliding;
+                detector.pending = 0;
+            }
+        } else {
+            detector.pending = 0;
+        }
+        detector.sliding
     }
 }
 
@@ -86,24 +93,24 @@ mod tests {
         let mut det = SlidingDetector::new();
         // 19 fast samples then a glitch: not yet sliding.
         for _ in 0..19 {
-            assert!(!det.update(&cfg, v(0.038)));
+            assert!(!cfg.process(&mut det, v(0.038)));
         }
-        assert!(!det.update(&cfg, v(0.0)));
+        assert!(!cfg.process(&mut det, v(0.0)));
         for _ in 0..19 {
-            assert!(!det.update(&cfg, v(-0.038)));
+            assert!(!cfg.process(&mut det, v(-0.038)));
         }
-        assert!(det.update(&cfg, v(-0.038)), "20th sample in a row");
+        assert!(cfg.process(&mut det, v(-0.038)), "20th sample in a row");
         // Between the thresholds: stays sliding for ever.
         for _ in 0..1_000 {
-            assert!(det.update(&cfg, v(0.7e-3)));
+            assert!(cfg.process(&mut det, v(0.7e-3)));
         }
         for _ in 0..19 {
-            assert!(det.update(&cfg, v(0.1e-3)));
+            assert!(cfg.process(&mut det, v(0.1e-3)));
         }
-        assert!(!det.update(&cfg, v(0.1e-3)));
+        assert!(!cfg.process(&mut det, v(0.1e-3)));
         // Between the thresholds again: stays stopped.
         for _ in 0..1_000 {
-            assert!(!det.update(&cfg, v(0.7e-3)));
+            assert!(!cfg.process(&mut det, v(0.7e-3)));
         }
         assert!(!det.is_sliding());
     }
@@ -115,8 +122,8 @@ mod tests {
             ..config()
         };
         let mut det = SlidingDetector::new();
-        assert!(det.update(&cfg, Q8_24::MIN)); // |MIN| saturates to MAX: fast
-        assert!(det.update(&cfg, Q8_24::MAX));
-        assert!(!det.update(&cfg, Q8_24::ZERO));
+        assert!(cfg.process(&mut det, Q8_24::MIN)); // |MIN| saturates to MAX: fast
+        assert!(cfg.process(&mut det, Q8_24::MAX));
+        assert!(!cfg.process(&mut det, Q8_24::ZERO));
     }
 }

@@ -87,9 +87,97 @@ pub const fn cos(phase: u32) -> Q1_31 {
     sin_cos(phase).1
 }
 
+/// A phase in turns, U0.32: `2^32` per turn, so its `u32` covers one turn, [0, 1), and adding
+/// two phases wraps exactly like the angle (a numerically controlled oscillator's
+/// accumulator). The resolution is 2^-32 turn (1.5e-9 rad). A negative phase is its wrap:
+/// -1/4 turn is 3/4.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Turns(u32);
+
+impl Turns {
+    /// Zero phase.
+    pub const ZERO: Self = Self(0);
+    /// A quarter turn (pi/2).
+    pub const QUARTER: Self = Self(1 << 30);
+    /// Half a turn (pi).
+    pub const HALF: Self = Self(1 << 31);
+
+    /// The phase whose U0.32 bits are `bits` (`bits / 2^32` of a turn).
+    pub const fn from_bits(bits: u32) -> Self {
+        Self(bits)
+    }
+
+    /// The U0.32 bits, `2^32` per turn.
+    pub const fn bits(self) -> u32 {
+        self.0
+    }
+
+    /// The phase of `turns` (any finite number of turns, either sign): its fraction of a turn,
+    /// rounded to the nearest 2^-32 turn, wrapped into [0, 1). `None` when `turns` is not
+    /// finite. Set-up and tools (`f64`).
+    pub fn from_turns(turns: f64) -> Option<Self> {
+        if !turns.is_finite() {
+            return None;
+        }
+        let fraction = turns - libm::floor(turns); // [0, 1]: 1 only by rounding of tiny negatives
+        let bits = libm::round(fraction * 4_294_967_296.0) as u64;
+        Some(Self((bits & 0xFFFF_FFFF) as u32))
+    }
+
+    /// The phase as a fraction of a turn, [0, 1), exact in `f64`.
+    pub fn to_turns(self) -> f64 {
+        f64::from(self.0) / 4_294_967_296.0
+    }
+
+    /// The sum of two phases, wrapped to one turn.
+    pub const fn wrapping_add(self, other: Self) -> Self {
+        Self(self.0.wrapping_add(other.0))
+    }
+
+    /// `(sin, cos)` of the phase, Q1.31: [`sin_cos`].
+    pub const fn sin_cos(self) -> (Q1_31, Q1_31) {
+        sin_cos(self.0)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_phase_in_turns_converts_at_its_extremes() {
+        // Zero, the last step below a full turn, a full turn (wraps to zero), a half.
+        assert_eq!(Turns::from_turns(0.0), Some(Turns::ZERO));
+        assert_eq!(Turns::from_turns(1.0), Some(Turns::ZERO));
+        assert_eq!(Turns::from_turns(0.5), Some(Turns::HALF));
+        assert_eq!(Turns::from_turns(0.25), Some(Turns::QUARTER));
+        let last = Turns::from_bits(u32::MAX);
+        assert_eq!(last.to_turns(), 1.0 - 1.0 / 4_294_967_296.0);
+        assert_eq!(Turns::from_turns(last.to_turns()), Some(last));
+        // Negative turns are their wrap; rounding just below a whole turn wraps to zero.
+        assert_eq!(Turns::from_turns(-0.25), Some(Turns::from_bits(3 << 30)));
+        assert_eq!(Turns::from_turns(-1e-12), Some(Turns::ZERO));
+        assert_eq!(Turns::from_turns(1e9 + 0.5), Some(Turns::HALF));
+        assert_eq!(Turns::from_turns(f64::NAN), None);
+        assert_eq!(Turns::from_turns(f64::INFINITY), None);
+        // Addition wraps like the angle.
+        assert_eq!(last.wrapping_add(Turns::from_bits(1)), Turns::ZERO);
+        assert_eq!(Turns::HALF.wrapping_add(Turns::HALF), Turns::ZERO);
+        // The sine of a phase against the f64 reference at the quadrant edges.
+        for phase in [
+            Turns::ZERO,
+            Turns::QUARTER,
+            Turns::HALF,
+            Turns::from_bits(3 << 30),
+            last,
+        ] {
+            let angle = phase.to_turns() * core::f64::consts::TAU;
+            let (s, c) = phase.sin_cos();
+            assert!((s.to_f64() - angle.sin()).abs() < 1e-9, "{phase:?}");
+            assert!((c.to_f64() - angle.cos()).abs() < 1e-9, "{phase:?}");
+        }
+    }
     use proptest::prelude::*;
 
     fn angle(phase: u32) -> f64 {

@@ -11,7 +11,7 @@
 //! position as `u32` turn fractions (a phase accumulator wraps exactly like the angle), shape
 //! factors from `fx::sin_cos` (error 1e-9).
 
-use crate::fx::{Q1_31, Q2_30, Q8_24, sin_cos};
+use crate::fx::{Q1_31, Q2_30, Q8_24, Turns};
 
 use super::ModelError;
 use super::contact_constants::{finite, non_negative, poisson, positive};
@@ -48,10 +48,10 @@ pub struct HornDisplacement {
 }
 
 impl HornShape {
-    /// Shape at `position_phase` = x / (2 L) as a fraction of 2^32 (pi x / L = 2 pi phase / 2^32;
-    /// x in [-L/2, L/2] is phase in [-2^30, 2^30], wrapped to `u32`). Cost: one `sin_cos`.
-    pub fn from_phase(position_phase: u32) -> Self {
-        let (sin_shape, cos_shape) = sin_cos(position_phase);
+    /// Shape at `position_phase` = x / (2 L) turns (pi x / L = 2 pi phase; x in [-L/2, L/2]
+    /// is the phase in [-1/4, 1/4] turn, wrapped). Cost: one `sin_cos`.
+    pub fn from_phase(position_phase: Turns) -> Self {
+        let (sin_shape, cos_shape) = position_phase.sin_cos();
         Self {
             sin_shape,
             cos_shape,
@@ -70,21 +70,23 @@ impl HornShape {
                 reason: "|x| must be <= L/2",
             });
         }
-        let turns = libm::round(x / (2.0 * length) * 4_294_967_296.0) as i64;
-        Ok(Self::from_phase(turns as u32)) // two's-complement wrap of a negative x: intended
+        // x / (2 L) in [-1/4, 1/4] turn, rounded to 2^-32 turn; a negative x is its wrap (the
+        // two's-complement wrap of the rounded count: intended).
+        let count = libm::round(x / (2.0 * length) * 4_294_967_296.0) as i64;
+        Ok(Self::from_phase(Turns::from_bits(count as u32)))
     }
 
-    /// u and v at the time phase `time_phase` (2 pi f t as a fraction of 2^32) for amplitudes
+    /// u and v at the time phase `time_phase` (f t turns, 2 pi f t rad) for amplitudes
     /// A and B in um (Q8.24, any sign). Error <= 2 ulp of Q8.24 + 2e-9 relative. Cost: one
     /// `sin_cos` and four multiplications; never fails (|P_u S| < 1 cannot overflow).
     pub fn displacement(
         &self,
         longitudinal_amplitude_um: Q8_24,
         vertical_amplitude_um: Q8_24,
-        time_phase: u32,
+        time_phase: Turns,
         u_phase: UPhase,
     ) -> HornDisplacement {
-        let (sin_t, cos_t) = sin_cos(time_phase);
+        let (sin_t, cos_t) = time_phase.sin_cos();
         let u_time = match u_phase {
             UPhase::InPhase => cos_t,
             UPhase::Quadrature => sin_t,
@@ -101,14 +103,16 @@ impl HornShape {
     }
 }
 
-/// Time phase 2 pi f t as a fraction of 2^32 (tool level, f64): frac(f t) 2^32, rounded.
+/// Time phase f t turns (2 pi f t rad; tool level, f64): frac(f t), rounded to 2^-32 turn.
 /// Errors: non-finite t, f <= 0. In firmware the phase comes from an accumulator instead.
-pub fn time_phase(frequency: f64, time: f64) -> Result<u32, ModelError> {
+pub fn time_phase(frequency: f64, time: f64) -> Result<Turns, ModelError> {
     let f = positive("f", frequency)?;
     let t = finite("t", time)?;
-    let cycles = f * t;
-    let fraction = cycles - libm::floor(cycles);
-    Ok((libm::round(fraction * 4_294_967_296.0) as u64 & 0xFFFF_FFFF) as u32)
+    // f t is finite here (both finite, f > 0 is checked; an overflow to infinity is refused).
+    Turns::from_turns(f * t).ok_or(ModelError::OutOfDomain {
+        input: "t",
+        reason: "f t must be finite",
+    })
 }
 
 /// An amplitude in m as um in Q8.24, for set-up and tools. Errors: non-finite, negative, or

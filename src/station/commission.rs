@@ -3,12 +3,12 @@
 //! to the controller. Kept apart from `station.rs` so that the loop's other commands read as
 //! before.
 
-use super::{Station, drive_amplitude, search_command};
+use super::Station;
 use crate::commission::{
     CellZero, CommissionResult, Commissioning, PeriodInputs, Phase, Refusal, Step,
 };
 use crate::control::{Config, Output};
-use crate::drive::Frequency;
+use crate::drive::{Amplitude, Frequency};
 use crate::fx::{Q1_31, Q16_16};
 use crate::protocol::{Command, ProtocolError, SupervisorState};
 use crate::sense::Calibration;
@@ -136,7 +136,7 @@ impl Station {
             fault: output.fault.is_some(),
         };
         let amplitude = match sequence.control(&inputs) {
-            Phase::Search => search_command(resonance.search_amplitude()),
+            Phase::Search => resonance.search_amplitude().command(),
             Phase::Drive(amplitude) => amplitude,
             Phase::DriveOffPinned => {
                 let here = resonance.tuning().frequency;
@@ -157,7 +157,7 @@ impl Station {
             output.amplitude = amplitude;
             self.controller.drive_replaced(amplitude);
         }
-        self.applied = drive_amplitude(output.amplitude);
+        self.applied = Amplitude::from_command(output.amplitude);
     }
 
     /// The loop on the measured values: the controller's envelope time constant (and the lead,

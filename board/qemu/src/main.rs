@@ -31,6 +31,7 @@ mod flash;
 mod irq;
 mod report;
 mod rig;
+mod stage;
 mod time_driver;
 mod uart;
 mod watchdog;
@@ -162,7 +163,13 @@ async fn supervisor_task(args: Args, control_spawner: SendSpawner) {
     } else {
         Mode::Scripted
     };
-    let rig = match time_driver::exclude(|| SimulatedRig::new(scene, mode)) {
+    // The two loop slots: the rig runs one; under the console the other is the spare a `scene`
+    // load is prepared in (`stage.rs`), so a load swaps them instead of copying a loop.
+    static ACTIVE_SLOT: StaticCell<sonolube_sim::ClosedLoop<'static>> = StaticCell::new();
+    static SPARE_SLOT: StaticCell<sonolube_sim::ClosedLoop<'static>> = StaticCell::new();
+    let rig = match time_driver::exclude(|| {
+        SimulatedRig::new(scene, mode, |run| ACTIVE_SLOT.init(run))
+    }) {
         Ok(rig) => rig.with_home(home),
         Err(error) => {
             // A scene refused for its control period: the selection line says which budget
@@ -178,6 +185,19 @@ async fn supervisor_task(args: Args, control_spawner: SendSpawner) {
     // The rig (the station, the simulated plant and the judge: about 25 KB) lives in a static,
     // and the control task holds a reference: passed by value, its copies on the way into the
     // task's future overflowed the 99 KB stack.
+    let spare = if args.serve {
+        match time_driver::exclude(|| sonolube_sim::ClosedLoop::operated(scene)) {
+            Ok(run) => Some(SPARE_SLOT.init(run)),
+            Err(error) => {
+                defmt::error!("scene {=str} cannot run: {}", scene.name, error);
+                exit::exit(exit::SELFCHECK_FAILED);
+            }
+        }
+    } else {
+        None
+    };
+    static STAGER: StaticCell<stage::SceneStager> = StaticCell::new();
+    let stager = STAGER.init(stage::SceneStager::new(spare));
     static RIG: StaticCell<Rig> = StaticCell::new();
     let rig = RIG.init(Persisted::new(rig, store, booted, false, known_scene));
     match control_task(rig, args) {
@@ -189,6 +209,7 @@ async fn supervisor_task(args: Args, control_spawner: SendSpawner) {
             exit::exit(exit::FAULT);
         }
     }
+    STAGER_FOR_CONSOLE.signal(stager);
 }
 
 #[embassy_executor::task]
@@ -231,9 +252,17 @@ async fn control_task(rig: &'static mut Rig, args: Args) {
     Qemu::finish(passed)
 }
 
+/// The console's stager of `scene` loads, handed over by the supervisor once the loops are
+/// built.
+static STAGER_FOR_CONSOLE: embassy_sync::signal::Signal<
+    embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex,
+    &'static mut stage::SceneStager,
+> = embassy_sync::signal::Signal::new();
+
 #[embassy_executor::task]
 async fn console_task(rx: uart::UartRx, tx: uart::UartTx, identity: &'static Identity) {
-    console::serve(rx, tx, identity).await
+    let stager = STAGER_FOR_CONSOLE.wait().await;
+    console::serve_preparing(rx, tx, identity, stager).await
 }
 
 /// Feeds the watchdog while the heartbeat (boot) or the control loop (after) advances.

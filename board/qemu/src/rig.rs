@@ -18,6 +18,7 @@ use sonolube_app::persist::Persistent;
 use sonolube_app::snapshot::Snapshot;
 use sonolube_sim::{ClosedLoop, Mode, RunSummary, SimError};
 
+use crate::stage::{self, ModelLine, Slot};
 use crate::{drive, time_driver};
 
 /// The simulated rig running one scene.
@@ -25,7 +26,9 @@ pub struct SimulatedRig {
     /// The scene the run was started with: the one the settings' defaults use.
     home: &'static Scene<'static>,
     scene: &'static Scene<'static>,
-    run: ClosedLoop<'static>,
+    /// The loop, in one of the two static slots: a `scene` load swaps it with the loop the
+    /// console prepared in the other ([`crate::stage`]), never copies it.
+    run: Slot,
     /// No command has changed the loop since it was built: settings for its scene go straight
     /// into it, without building another.
     pristine: bool,
@@ -42,7 +45,13 @@ impl SimulatedRig {
     /// sequence period by period, then the scene's run is built on the measured values
     /// ([`ClosedLoop::with_commissioned`]), the same as the host's `commission_rig` and
     /// `ClosedLoop::new`.
-    pub fn new(scene: &'static Scene<'static>, mode: Mode) -> Result<Self, SimError> {
+    ///
+    /// `place` puts the built loop in one of the two static slots.
+    pub fn new(
+        scene: &'static Scene<'static>,
+        mode: Mode,
+        place: impl FnOnce(ClosedLoop<'static>) -> Slot,
+    ) -> Result<Self, SimError> {
         let commissioning = mode == Mode::Scripted && scene.commission;
         let rig_scene = sonolube_sim::rig_scene(scene);
         let mut run = match mode {
@@ -53,6 +62,7 @@ impl SimulatedRig {
         if commissioning {
             sonolube_sim::start_rig_commission(&mut run)?;
         }
+        let run = place(run);
         Ok(Self {
             home: scene,
             scene,
@@ -76,24 +86,14 @@ impl SimulatedRig {
     /// Logs the model variant the controller runs and why ([`sonolube::variant::select`]), at
     /// scene start.
     pub fn log_model(&self) {
-        let station = self.run.station();
-        match station.selection() {
-            Some(selection) => {
-                defmt::info!("scene {=str}: controller {}", self.scene.name, selection)
-            }
-            None => defmt::info!(
-                "scene {=str}: controller model {} (given, not selected)",
-                self.scene.name,
-                station.model().kind()
-            ),
-        }
+        ModelLine::of(self.scene.name, self.run).log();
     }
 
     /// After a commissioning period: when the sequence has ended, the scene's run on the
     /// measured values replaces the rig (the watchdog fed on either side of the build, as for
     /// `load`); a refusal ends the run as a failure.
     fn after_commissioning_period(&mut self) {
-        let Some(outcome) = sonolube_sim::rig_commission_outcome(&self.run) else {
+        let Some(outcome) = sonolube_sim::rig_commission_outcome(self.run) else {
             return;
         };
         self.commissioning = false;
@@ -113,7 +113,7 @@ impl SimulatedRig {
         });
         match built {
             Ok(run) => {
-                self.run = run;
+                *self.run = run;
                 drive::set(sonolube::fx::Q1_31::ZERO);
                 self.log_commissioned();
             }
@@ -170,47 +170,37 @@ impl SimulatedRig {
         time_driver::exclude(|| self.run.summary())
     }
 
-    /// `scene NAME` under the console: a new rig with that scene's plant and station, when
-    /// the drive is off.
+    /// `scene NAME` under the console, at a step boundary: the loop the console prepared
+    /// ([`crate::stage::SceneStager`]) replaces the rig's when the drive is off. A swap of
+    /// two references: the build, the feasibility check and the selection line were done in
+    /// the console's task, out of the control step.
     fn select_scene(&mut self, command: &Command, name: SceneName) -> Result<(), ProtocolError> {
-        use sonolube::protocol::SupervisorState::{Boot, Fault, Idle};
+        let Some(staged) = stage::take_staged() else {
+            return Err(ProtocolError::Unavailable {
+                command: command.keyword(),
+                reason: "the scene was not prepared",
+            });
+        };
         let state = self.run.controller().state();
-        if !matches!(state, Idle | Fault | Boot) {
+        if !stage::drive_off(state) {
+            stage::give_back(staged.run);
             return Err(ProtocolError::WrongState {
                 command: command.keyword(),
                 state,
             });
         }
-        let unknown = ProtocolError::UnknownScene { name };
-        let Some(scene) = sonolube::scene::builtin::find(name.as_str()) else {
-            return Err(unknown);
-        };
-        let run = time_driver::exclude(|| ClosedLoop::operated(scene));
-        match run {
-            Ok(run) => {
-                // What cannot work is refused before it runs (issue 26); the built-in scenes
-                // all pass (`sonolube::scene::feasibility` tests).
-                // Judged out of the firmware's clock, like the build: the check is about 2.5 ms
-                // of soft f64 at 25 MHz, run with the drive off, and on this board commands run
-                // inside a control step. Its findings are logged at the next scene start.
-                let feasibility = time_driver::exclude(|| run.station().feasibility(scene));
-                if let Some(refusal) = feasibility.refusal() {
-                    return Err(ProtocolError::Unavailable {
-                        command: command.keyword(),
-                        reason: refusal.summary(),
-                    });
-                }
-                self.scene = scene;
-                self.run = run;
-                self.pristine = true;
-                self.log_model();
-                Ok(())
-            }
-            Err(error) => {
-                defmt::error!("scene {=str} cannot run: {}", name.as_str(), error);
-                Err(unknown)
-            }
+        if staged.scene.name != name.as_str() {
+            stage::give_back(staged.run);
+            return Err(ProtocolError::Unavailable {
+                command: command.keyword(),
+                reason: "another scene was prepared",
+            });
         }
+        let previous = core::mem::replace(&mut self.run, staged.run);
+        stage::give_back(previous);
+        self.scene = staged.scene;
+        self.pristine = true;
+        Ok(())
     }
 }
 
@@ -256,7 +246,7 @@ impl Persistent for SimulatedRig {
         time_driver::exclude(|| sonolube::settings::apply(run.station_mut(), record))?;
         let changed = !core::ptr::eq(scene, self.scene);
         self.scene = scene;
-        self.run = run;
+        *self.run = run;
         self.pristine = false;
         if changed {
             self.log_model();
