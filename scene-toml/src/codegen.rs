@@ -250,6 +250,7 @@ fn target_point(p: &TargetPoint) -> String {
         Target::Reduction { reduction_mpct } => {
             format!("Target::Reduction {{ reduction_mpct: {reduction_mpct} }}")
         }
+        Target::NetForce { force_mn } => format!("Target::NetForce {{ force_mn: {force_mn} }}"),
     };
     format!(
         "TargetPoint {{ at_s: {}, target: {target}, ramp: {} }}",

@@ -169,6 +169,7 @@ pub(crate) struct RawTargetPoint {
     pub force_n: Option<f64>,
     pub coef: Option<f64>,
     pub reduction_pct: Option<f64>,
+    pub net_force_n: Option<f64>,
     pub ramp: Option<bool>,
 }
 
