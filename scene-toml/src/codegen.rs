@@ -170,12 +170,13 @@ fn stack(s: &Stack) -> String {
 fn horn(h: &Horn) -> String {
     format!(
         "Horn {{ length_m: {}, width_m: {}, thickness_m: {}, vertical_amplitude_m: {}, \
-         contact_position_m: {} }}",
+         contact_position_m: {}, motor_regions: {} }}",
         num(h.length_m),
         num(h.width_m),
         num(h.thickness_m),
         num(h.vertical_amplitude_m),
         num(h.contact_position_m),
+        h.motor_regions,
     )
 }
 

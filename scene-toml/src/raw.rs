@@ -93,6 +93,7 @@ pub(crate) struct RawHorn {
     pub thickness_m: f64,
     pub vertical_amplitude_m: f64,
     pub contact_position_m: f64,
+    pub motor_regions: Option<bool>,
 }
 
 /// `[transducer]`.
