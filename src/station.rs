@@ -43,6 +43,7 @@ mod commission;
 
 pub use commission::CommissionReport;
 use commission::CommissionState;
+mod motor_hold;
 mod reach;
 
 /// What a board gives the station each period.
@@ -139,6 +140,9 @@ pub struct Station {
     quality_factor: f64,
     controller_mu: f64,
     target_warning: Option<crate::protocol::Target>,
+    /// The block's place on a horn and the net-force hold (issue 27); `None` for a scene the
+    /// motor model does not describe (`motor_hold`).
+    motor: Option<motor_hold::MotorHold>,
 }
 
 /// `freq auto` refused: the board samples no drive current.
@@ -224,6 +228,8 @@ impl Station {
         let start = Frequency::from_millihertz(libm::round(scene.transducer.drive_hz * 1e3) as u32);
         let resonance =
             ResonanceLoop::new(&ResonanceSettings::around(&stack), start, DRIVE_CLOCK).ok();
+        let motor =
+            motor_hold::MotorHold::for_scene(scene, settings).map_err(StationError::Model)?;
         Ok(Self {
             model,
             selection,
@@ -252,6 +258,7 @@ impl Station {
             quality_factor: scene.transducer.quality_factor,
             controller_mu: scene.controller.mu,
             target_warning: None,
+            motor,
         })
     }
 
@@ -331,6 +338,20 @@ impl Station {
             sensor_fault,
         };
         let mut output = self.controller.step(&inputs, &self.model);
+        // Issue 27: in a motor region the net-force hold drives instead of the friction path.
+        if let Some(motor) = self.motor.as_mut()
+            && let motor_hold::HoldOutcome::Motor(amplitude) = motor.step(
+                sample.sliding_velocity_m_per_s,
+                self.controller.target(),
+                &output,
+                normal_force,
+                tangential_force,
+            )
+        {
+            let amplitude = amplitude.min(self.controller.config().limit().max_amplitude);
+            output.amplitude = amplitude;
+            self.controller.drive_replaced(amplitude);
+        }
         if let Some(resonance) = self.resonance.as_ref() {
             let drive_allowed = output.fault.is_none()
                 && (self.start_pending
@@ -713,6 +734,12 @@ impl Station {
         self.selection.as_ref()
     }
 
+    /// The block's position on the horn, m from the centre, as the station tracks it from the
+    /// sliding velocity (issue 27); `None` for a scene without the motor model.
+    pub fn block_position_m(&self) -> Option<f64> {
+        self.motor.as_ref().map(motor_hold::MotorHold::position_m)
+    }
+
     /// The controller's friction model.
     pub fn model(&self) -> &AnyModel {
         &self.model
@@ -749,6 +776,11 @@ impl Station {
         }
         let settings = tuned(&settings)?;
         let gains = gain_schedule(&settings)?;
+        if let Some(motor) = self.motor.as_mut() {
+            motor
+                .retune(&settings)
+                .map_err(|_| ConfigError::OutOfRange { setting: "kp" })?;
+        }
         // Always accepted (bumpless in every state).
         let _ = self.controller.set_gains(gains);
         self.settings = settings;

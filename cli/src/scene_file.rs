@@ -87,7 +87,8 @@ impl LoadedScene {
 
 /// The friction ratio F'/F that the scene's target asks of its plant at `t_s`: 1 - reduction,
 /// or the target coefficient or force over the plant's natural friction there. `None` before
-/// the first target point or without load.
+/// the first target point or without load, and for a net-force target (issue 27), which is
+/// no friction ratio (the motor hold reports its own reach while running).
 pub fn target_ratio(scene: &Scene<'_>, t_s: f32) -> Option<f64> {
     let load = f64::from(interpolate(scene.normal_load_n, t_s));
     let speed = f64::from(interpolate(scene.sliding_velocity_m_per_s, t_s)).abs();
@@ -96,6 +97,7 @@ pub fn target_ratio(scene: &Scene<'_>, t_s: f32) -> Option<f64> {
         Target::Reduction { reduction_mpct } => 1.0 - f64::from(reduction_mpct) * 1e-5,
         Target::Coef { coef_ppm } => f64::from(coef_ppm) * 1e-6 * load / natural,
         Target::Force { force_mn } => f64::from(force_mn) * 1e-3 / natural,
+        Target::NetForce { .. } => return None,
     };
     (load > 0.0).then_some(ratio)
 }

@@ -74,6 +74,10 @@ impl Firmware {
         match self.target {
             Some(Target::Coef { coef_ppm }) => f64::from(coef_ppm) * 1e-6,
             Some(Target::Force { force_mn }) => f64::from(force_mn) * 1e-3 / NORMAL_N,
+            // This stand-in plant has friction only: a net force acts as its magnitude.
+            Some(Target::NetForce { force_mn }) => {
+                f64::from(force_mn.unsigned_abs()) * 1e-3 / NORMAL_N
+            }
             Some(Target::Reduction { reduction_mpct }) => {
                 NATURAL_MU * (1.0 - f64::from(reduction_mpct) * 1e-5)
             }

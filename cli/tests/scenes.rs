@@ -393,8 +393,19 @@ fn error_after(from: &str, to: &str) -> scene_toml::SceneError {
 }
 
 #[test]
+fn a_negative_net_force_target_loads_signed() {
+    let text = reference_text().replacen("reduction_pct = 50.0", "net_force_n = -2.5", 1);
+    let scene = scene_toml::parse(&text, "edited.toml").expect("loads");
+    let last = scene.target.last().expect("points");
+    assert_eq!(
+        last.target,
+        scene_toml::Target::NetForce { force_mn: -2_500 }
+    );
+}
+
+#[test]
 fn broken_files_are_refused_with_file_key_and_reason() {
-    let cases: [(&str, &str, &str, &str); 13] = [
+    let cases: [(&str, &str, &str, &str); 16] = [
         ("duration_s = 0.025\n", "", "duration_s", "missing field"),
         (
             "duration_s = 0.025",
@@ -444,6 +455,25 @@ fn broken_files_are_refused_with_file_key_and_reason() {
             "coef = 0.1\nramp = true",
             "profiles.target[1].ramp",
             "same kind",
+        ),
+        // The signed net force (issue 27): its range is the command's, +-50 kN, at 1 mN.
+        (
+            "reduction_pct = 50.0",
+            "net_force_n = -50000.001",
+            "profiles.target[1].net_force_n",
+            "outside -50000 ..= 50000",
+        ),
+        (
+            "reduction_pct = 50.0",
+            "net_force_n = -1.0001",
+            "profiles.target[1].net_force_n",
+            "resolution",
+        ),
+        (
+            "reduction_pct = 50.0",
+            "reduction_pct = 50.0\nnet_force_n = 1.0",
+            "profiles.target[1]",
+            "exactly one of",
         ),
         (
             "load_range_n = [4.155, 4.155]",

@@ -170,12 +170,13 @@ fn stack(s: &Stack) -> String {
 fn horn(h: &Horn) -> String {
     format!(
         "Horn {{ length_m: {}, width_m: {}, thickness_m: {}, vertical_amplitude_m: {}, \
-         contact_position_m: {} }}",
+         contact_position_m: {}, motor_regions: {} }}",
         num(h.length_m),
         num(h.width_m),
         num(h.thickness_m),
         num(h.vertical_amplitude_m),
         num(h.contact_position_m),
+        h.motor_regions,
     )
 }
 
@@ -250,6 +251,7 @@ fn target_point(p: &TargetPoint) -> String {
         Target::Reduction { reduction_mpct } => {
             format!("Target::Reduction {{ reduction_mpct: {reduction_mpct} }}")
         }
+        Target::NetForce { force_mn } => format!("Target::NetForce {{ force_mn: {force_mn} }}"),
     };
     format!(
         "TargetPoint {{ at_s: {}, target: {target}, ramp: {} }}",

@@ -187,6 +187,7 @@ pub(crate) fn horn(errors: Errors<'_>, raw: &RawHorn) -> Result<Horn, SceneError
             -0.5 * length_m,
             0.5 * length_m,
         )?,
+        motor_regions: raw.motor_regions.unwrap_or(false),
     })
 }
 

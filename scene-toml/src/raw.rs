@@ -93,6 +93,7 @@ pub(crate) struct RawHorn {
     pub thickness_m: f64,
     pub vertical_amplitude_m: f64,
     pub contact_position_m: f64,
+    pub motor_regions: Option<bool>,
 }
 
 /// `[transducer]`.
@@ -169,6 +170,7 @@ pub(crate) struct RawTargetPoint {
     pub force_n: Option<f64>,
     pub coef: Option<f64>,
     pub reduction_pct: Option<f64>,
+    pub net_force_n: Option<f64>,
     pub ramp: Option<bool>,
 }
 

@@ -153,24 +153,57 @@ fn target(
         if points.last().is_some_and(|p| at_s <= p.at_s) {
             return Err(errors.at(&format!("{at}.at_s"), "times must increase strictly"));
         }
-        let target = match (point.force_n, point.coef, point.reduction_pct) {
-            (Some(v), None, None) => Target::Force {
-                force_mn: scaled(errors, &format!("{at}.force_n"), v, 1e3, (1, 50_000_000))?,
+        // The ranges are the `target` command's (sonolube::protocol::quantity), each bound
+        // fitting its field: the conversions below cannot fail.
+        let unsigned = |units: i64| u32::try_from(units).unwrap_or(u32::MAX);
+        let target = match (
+            point.force_n,
+            point.coef,
+            point.reduction_pct,
+            point.net_force_n,
+        ) {
+            (Some(v), None, None, None) => Target::Force {
+                force_mn: unsigned(scaled(
+                    errors,
+                    &format!("{at}.force_n"),
+                    v,
+                    1e3,
+                    (1, 50_000_000),
+                )?),
             },
-            (None, Some(v), None) => Target::Coef {
-                coef_ppm: scaled(errors, &format!("{at}.coef"), v, 1e6, (1, 2_000_000))?,
+            (None, Some(v), None, None) => Target::Coef {
+                coef_ppm: unsigned(scaled(
+                    errors,
+                    &format!("{at}.coef"),
+                    v,
+                    1e6,
+                    (1, 2_000_000),
+                )?),
             },
-            (None, None, Some(v)) => Target::Reduction {
-                reduction_mpct: scaled(
+            (None, None, Some(v), None) => Target::Reduction {
+                reduction_mpct: unsigned(scaled(
                     errors,
                     &format!("{at}.reduction_pct"),
                     v,
                     1e3,
                     (0, 99_999),
-                )?,
+                )?),
+            },
+            (None, None, None, Some(v)) => Target::NetForce {
+                force_mn: i32::try_from(scaled(
+                    errors,
+                    &format!("{at}.net_force_n"),
+                    v,
+                    1e3,
+                    (-50_000_000, 50_000_000),
+                )?)
+                .unwrap_or(i32::MAX),
             },
             _ => {
-                return Err(errors.at(&at, "needs exactly one of force_n, coef, reduction_pct"));
+                return Err(errors.at(
+                    &at,
+                    "needs exactly one of force_n, coef, reduction_pct, net_force_n",
+                ));
             }
         };
         let same_kind = |p: &TargetPoint| {
@@ -193,8 +226,8 @@ fn scaled(
     key: &str,
     value: f64,
     scale: f64,
-    (lo, hi): (u32, u32),
-) -> Result<u32, SceneError> {
+    (lo, hi): (i64, i64),
+) -> Result<i64, SceneError> {
     let units = value * scale;
     let rounded = units.round();
     if !units.is_finite() || (units - rounded).abs() > 1e-6 * rounded.abs().max(1.0) {
@@ -203,18 +236,19 @@ fn scaled(
             format!("{value} is finer than the resolution 1/{scale}"),
         ));
     }
-    if rounded < f64::from(lo) || rounded > f64::from(hi) {
+    // The bounds are at most 5e7 in magnitude: exact in f64.
+    if rounded < lo as f64 || rounded > hi as f64 {
         return Err(errors.at(
             key,
             format!(
                 "{value} is outside {} ..= {}",
-                f64::from(lo) / scale,
-                f64::from(hi) / scale
+                lo as f64 / scale,
+                hi as f64 / scale
             ),
         ));
     }
-    // In range of u32 by the check above.
-    Ok(rounded as u32)
+    // Within lo ..= hi by the check above.
+    Ok(rounded as i64)
 }
 
 fn fault(

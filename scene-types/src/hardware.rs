@@ -63,6 +63,11 @@ pub struct Horn {
     /// Contact position x measured from the vibration node, m, |x| <= L/2. At x = 0 the
     /// longitudinal component u = A sin(pi x / L) vanishes.
     pub contact_position_m: f64,
+    /// The block travels along the horn through seed 001 Table 1's regions (issue 27): its
+    /// position is tracked from the sliding velocity, the plant's horn drives it by the motor
+    /// model outside the measured transition region, and a net-force target is held there.
+    /// False (the default): the contact stays where it is, friction reduction only.
+    pub motor_regions: bool,
 }
 
 /// The resonant transducer: envelope dynamics and the Butterworth-Van Dyke electrical model

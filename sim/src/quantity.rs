@@ -3,6 +3,9 @@
 //! (friction / normal load) for a coefficient target, friction ratio (friction / natural
 //! friction) against `1 - reduction` for a reduction target. Friction is taken as a
 //! magnitude (the plant signs it like the sliding velocity; the controller uses `|F_t|`).
+//! A net-force target (issue 27) is judged signed: the horn's force on the block along +x,
+//! which is minus the plant's signed tangential force (the force the block drags the horn
+//! and the cell with, signed like the sliding velocity for friction).
 
 use crate::plant::GroundTruth;
 use sonolube::protocol::Target;
@@ -17,6 +20,8 @@ pub enum Quantity {
     Coefficient,
     /// Friction force, N.
     Force,
+    /// Net tangential force of the horn on the block along +x, N, signed.
+    NetForce,
 }
 
 impl Quantity {
@@ -26,15 +31,17 @@ impl Quantity {
             Target::Force { .. } => Quantity::Force,
             Target::Coef { .. } => Quantity::Coefficient,
             Target::Reduction { .. } => Quantity::Ratio,
+            Target::NetForce { .. } => Quantity::NetForce,
         }
     }
 
-    /// Short name for tables and CSV headers: `ratio`, `coef`, `force_n`.
+    /// Short name for tables and CSV headers: `ratio`, `coef`, `force_n`, `net_force_n`.
     pub const fn name(self) -> &'static str {
         match self {
             Quantity::Ratio => "ratio",
             Quantity::Coefficient => "coef",
             Quantity::Force => "force_n",
+            Quantity::NetForce => "net_force_n",
         }
     }
 }
@@ -45,7 +52,8 @@ impl Quantity {
 pub struct Judged {
     /// The quantity.
     pub quantity: Quantity,
-    /// The target's value: `1 - reduction`, the coefficient, or the force in N; > 0.
+    /// The target's value: `1 - reduction`, the coefficient, or the force in N; > 0 but for
+    /// the net force (N along +x, either sign).
     pub target: f32,
     /// The plant's true value; NaN where it is undefined (no natural friction, no load).
     pub actual: f32,
@@ -67,6 +75,7 @@ impl Judged {
             Quantity::Ratio => per(truth.contact.natural_friction_n),
             Quantity::Coefficient => per(truth.normal_load_n),
             Quantity::Force => friction,
+            Quantity::NetForce => -truth.contact.friction_n,
         };
         Self {
             quantity,
@@ -75,7 +84,7 @@ impl Judged {
         }
     }
 
-    /// `(actual - target) / target`, signed (target values are > 0); NaN if `actual` is.
+    /// `(actual - target) / |target|`, signed; NaN if `actual` is.
     pub fn relative_error(&self) -> f32 {
         (self.actual - self.target) / libm::fabsf(self.target)
     }
@@ -91,6 +100,7 @@ pub fn target_value(target: &Target) -> f32 {
         }
         Target::Coef { coef_ppm } => coef_ppm as f32 / 1e6,
         Target::Force { force_mn } => force_mn as f32 / 1e3,
+        Target::NetForce { force_mn } => force_mn as f32 / 1e3,
     }
 }
 
@@ -102,6 +112,9 @@ pub fn target_friction_n(target: &Target, truth: &GroundTruth) -> f32 {
         Quantity::Ratio => value * truth.contact.natural_friction_n,
         Quantity::Coefficient => value * truth.normal_load_n,
         Quantity::Force => value,
+        // The tangential force the net-force target asks for, as a magnitude like the
+        // others (the horn's force on the block is minus the cell's reading).
+        Quantity::NetForce => libm::fabsf(value),
     }
 }
 
@@ -138,6 +151,15 @@ mod tests {
         assert_eq!(judged.quantity.name(), "force_n");
         assert!((judged.actual - natural).abs() < 1e-5);
         assert_eq!(target_friction_n(&force, &truth), 0.5);
+        // The net force is the horn's force on the block: sliding at +x with the drive
+        // off, that is friction towards -x.
+        assert!(truth.sliding_velocity_m_per_s > 0.0);
+        let net = Target::NetForce { force_mn: -500 };
+        let judged = Judged::new(&net, &truth);
+        assert_eq!(judged.quantity.name(), "net_force_n");
+        assert_eq!(judged.target, -0.5);
+        assert!((judged.actual + natural).abs() < 1e-5);
+        assert!((judged.relative_error() + (natural - 0.5) / 0.5).abs() < 1e-4);
     }
 
     #[test]

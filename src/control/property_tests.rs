@@ -79,7 +79,7 @@ proptest! {
                 Command::Stop => prop_assert!(ctl.stop().is_ok()),
                 Command::Clear => { let _ = ctl.clear_fault(); }
                 Command::Target(kind, value) => {
-                    let target = Target::from_kind(["force", "coef", "reduction"][kind as usize], value).unwrap();
+                    let target = Target::from_kind(["force", "coef", "reduction"][kind as usize], i64::from(value)).unwrap();
                     prop_assert_eq!(ctl.set_target(target).is_ok(), target.is_valid());
                 }
                 Command::Gains(kp, ki) => {

@@ -4,7 +4,10 @@
 //! is what the friction model maps to an amplitude. The three protocol targets become:
 //! - `Force { force_mn }`: `r = F / (mu0 F_n)`, per step (the normal load moves);
 //! - `Coef { coef_ppm }`: `r = coef / mu0`;
-//! - `Reduction { reduction_mpct }`: `r = 1 - reduction`.
+//! - `Reduction { reduction_mpct }`: `r = 1 - reduction`;
+//! - `NetForce { force_mn }` (issue 27): in the horn's transition region the horn's force on
+//!   a sliding block is friction, so the friction path holds its magnitude as a force target;
+//!   in a motor region the station's net-force hold (`super::net_force`) drives instead.
 //!
 //! [`PreparedTarget::new`] does the decimal scaling (one integer division each) when the target
 //! is set; [`PreparedTarget::ratio`] then needs only reciprocal multiplies per step. A ratio
@@ -41,6 +44,11 @@ impl PreparedTarget {
         let scaled = target.scaled_value() as i32;
         let prepared = match target {
             Target::Force { .. } => Self::Force(ForceQ::from_ratio(scaled, 1_000).ok()?),
+            Target::NetForce { force_mn } => {
+                // |F| <= 50 kN by the range check: fits i32 and Q18.14.
+                let magnitude = force_mn.unsigned_abs() as i32;
+                Self::Force(ForceQ::from_ratio(magnitude, 1_000).ok()?)
+            }
             Target::Coef { .. } => {
                 // 2.0 itself (2_000_000 ppm) does not fit Q2.30: take the largest value.
                 let coef = Q2_30::from_ratio(scaled, 1_000_000).unwrap_or(Q2_30::MAX);

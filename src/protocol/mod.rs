@@ -194,8 +194,8 @@ pub use number::{
 };
 pub use parse::parse_command;
 pub use quantity::{
-    ALL_QUANTITIES, CAL_LOAD, DRIVE_FREQ, Quantity, TARGET_COEF, TARGET_FORCE, TARGET_REDUCTION,
-    TELEMETRY_RATE,
+    ALL_QUANTITIES, CAL_LOAD, DRIVE_FREQ, Quantity, TARGET_COEF, TARGET_FORCE, TARGET_NET_FORCE,
+    TARGET_REDUCTION, TELEMETRY_RATE,
 };
 pub use reach::{BEYOND_REACH, ReachState, ResonanceDistance, RunReach, format_target_ack};
 pub use reading::LoopReading;

@@ -9,18 +9,20 @@ use super::error::{ProtocolError, TokenText};
 use super::name::SceneName;
 use super::number::parse_decimal;
 use super::quantity::{
-    CAL_LOAD, DRIVE_FREQ, Quantity, TARGET_COEF, TARGET_FORCE, TARGET_REDUCTION, TELEMETRY_RATE,
+    CAL_LOAD, DRIVE_FREQ, Quantity, TARGET_COEF, TARGET_FORCE, TARGET_NET_FORCE, TARGET_REDUCTION,
+    TELEMETRY_RATE,
 };
 use super::target::Target;
 
 // Usages quoted by `missing-argument` and `extra-argument` replies.
-const USAGE_TARGET: &str = "target force|coef|reduction <value>";
+const USAGE_TARGET: &str = "target force|coef|reduction|net-force <value>";
 const USAGE_TARGET_FORCE: &str = "target force <newtons>";
 const USAGE_TARGET_COEF: &str = "target coef <mu>";
 const USAGE_TARGET_REDUCTION: &str = "target reduction <percent>";
+const USAGE_TARGET_NET_FORCE: &str = "target net-force <newtons along +x>";
 const USAGE_SCENE: &str = "scene list|<name>";
 const USAGE_FREQ: &str = "freq auto|<hertz>";
-const USAGE_TARGET_KINDS: &str = "force|coef|reduction";
+const USAGE_TARGET_KINDS: &str = "force|coef|reduction|net-force";
 const USAGE_TARE: &str = "tare normal|tangential|all";
 const USAGE_CAL: &str = "cal normal|tangential <newtons>";
 const USAGE_TELEMETRY: &str = "telemetry off|<hertz>";
@@ -155,10 +157,14 @@ fn parse_target(words: &mut Words<'_>) -> Result<(Command, &'static str), Protoc
         "force" => (&TARGET_FORCE, USAGE_TARGET_FORCE),
         "coef" => (&TARGET_COEF, USAGE_TARGET_COEF),
         "reduction" => (&TARGET_REDUCTION, USAGE_TARGET_REDUCTION),
+        "net-force" => (&TARGET_NET_FORCE, USAGE_TARGET_NET_FORCE),
         _ => return Err(bad_kind()),
     };
-    let value = quantity(required(words, usage)?, quantity_of)?;
-    let target = Target::from_kind(kind, value).ok_or_else(bad_kind)?;
+    let token = required(words, usage)?;
+    let value = signed_quantity(token, quantity_of)?;
+    // In range, the value fits the kind's field (checked for every quantity in `quantity`'s
+    // tests); a misfit would still be refused, never wrapped.
+    let target = Target::from_kind(kind, value).ok_or_else(|| out_of_range(token, quantity_of))?;
     Ok((Command::Target(target), usage))
 }
 
@@ -216,6 +222,16 @@ fn quantity(token: &str, quantity: &'static Quantity) -> Result<u32, ProtocolErr
     u32::try_from(value).map_err(|_| out_of_range(token, quantity))
 }
 
+/// A value of `quantity` in range, signed (the target kinds; the net force can be negative).
+fn signed_quantity(token: &str, quantity: &'static Quantity) -> Result<i64, ProtocolError> {
+    let value = parse_decimal(token, quantity.decimals)
+        .map_err(|error| ProtocolError::from_number(error, token, quantity))?;
+    if !quantity.contains(value) {
+        return Err(out_of_range(token, quantity));
+    }
+    Ok(value)
+}
+
 fn out_of_range(token: &str, quantity: &'static Quantity) -> ProtocolError {
     ProtocolError::OutOfRange {
         token: TokenText::new(token),
@@ -263,6 +279,14 @@ mod tests {
                 Command::Target(Target::Reduction {
                     reduction_mpct: 40_000,
                 }),
+            ),
+            (
+                "target net-force -5.25",
+                Command::Target(Target::NetForce { force_mn: -5_250 }),
+            ),
+            (
+                "target net-force +0",
+                Command::Target(Target::NetForce { force_mn: 0 }),
             ),
             ("scene list", Command::SceneList),
             ("scene ramp-up_2", Command::Scene(scene)),
@@ -372,6 +396,32 @@ mod tests {
         for (line, expected) in cases {
             assert_eq!(code(line), expected, "{line:?}");
         }
+    }
+
+    /// The signed kind's malformed and out-of-range values are refused with an error reply
+    /// that names the token and the range, never wrapped or clamped.
+    #[test]
+    fn net_force_refusals() {
+        for (line, expected) in [
+            ("target net-force", ErrorCode::MissingArgument),
+            ("target net-force --5", ErrorCode::BadNumber),
+            ("target net-force -", ErrorCode::BadNumber),
+            ("target net-force 5N", ErrorCode::TrailingGarbage),
+            ("target net-force -1.0001", ErrorCode::TooManyDecimals),
+            ("target net-force -50000.001", ErrorCode::OutOfRange),
+            ("target net-force 50000.001", ErrorCode::OutOfRange),
+            ("target net-force -999999999.999", ErrorCode::OutOfRange),
+            ("target net-force -9999999999.999", ErrorCode::TooManyDigits),
+            ("target net-force 1 2", ErrorCode::ExtraArgument),
+            ("target netforce 1", ErrorCode::BadChoice),
+        ] {
+            assert_eq!(code(line), expected, "{line:?}");
+        }
+        let reply = message("target net-force -60000");
+        assert!(
+            reply.contains("-50000.000 <= net-force <= 50000.000 N"),
+            "{reply}"
+        );
     }
 
     #[test]

@@ -116,6 +116,19 @@ pub const TARGET_REDUCTION: Quantity = Quantity {
     max_excluded: true,
 };
 
+/// `target net-force`: net tangential force of the horn on the block in N along +x, signed,
+/// `-50000 <= F <= 50000`, resolution 0.001 N (value in mN; issue 27). Zero is a valid target:
+/// no net force.
+pub const TARGET_NET_FORCE: Quantity = Quantity {
+    name: "net-force",
+    unit: "N",
+    decimals: 3,
+    min: -50_000_000,
+    min_excluded: false,
+    max: 50_000_000,
+    max_excluded: false,
+};
+
 /// `freq`: drive frequency in Hz, `20000 <= f <= 60000`, resolution 0.01 Hz (value in cHz).
 pub const DRIVE_FREQ: Quantity = Quantity {
     name: "freq",
@@ -151,10 +164,11 @@ pub const TELEMETRY_RATE: Quantity = Quantity {
 };
 
 /// Every quantity, for tests and for documentation tools.
-pub const ALL_QUANTITIES: [&Quantity; 6] = [
+pub const ALL_QUANTITIES: [&Quantity; 7] = [
     &TARGET_FORCE,
     &TARGET_COEF,
     &TARGET_REDUCTION,
+    &TARGET_NET_FORCE,
     &DRIVE_FREQ,
     &CAL_LOAD,
     &TELEMETRY_RATE,
@@ -192,6 +206,10 @@ mod tests {
         assert_eq!(range(&TARGET_FORCE), "0.000 < force <= 50000.000 N");
         assert_eq!(range(&TARGET_COEF), "0.000000 < coef <= 2.000000");
         assert_eq!(range(&TARGET_REDUCTION), "0.000 <= reduction < 100.000 %");
+        assert_eq!(
+            range(&TARGET_NET_FORCE),
+            "-50000.000 <= net-force <= 50000.000 N"
+        );
         assert_eq!(range(&DRIVE_FREQ), "20000.00 <= freq <= 60000.00 Hz");
         assert_eq!(range(&CAL_LOAD), "0.000 < load <= 50000.000 N");
         assert_eq!(range(&TELEMETRY_RATE), "1 <= rate <= 10000 Hz");
@@ -209,19 +227,25 @@ mod tests {
             assert!(quantity.contains(quantity.max_valid()));
             assert!(!quantity.contains(quantity.min_valid() - 1));
             assert!(!quantity.contains(quantity.max_valid() + 1));
-            // Every valid value fits the u32 fields of the commands.
-            assert!(u32::try_from(quantity.max_valid()).is_ok());
-            assert!(quantity.min_valid() >= 0);
+            // Every valid value fits the fields of the commands: u32, or i32 for the one
+            // signed quantity (the net force).
+            if quantity.min_valid() < 0 {
+                assert!(i32::try_from(quantity.min_valid()).is_ok());
+                assert!(i32::try_from(quantity.max_valid()).is_ok());
+            } else {
+                assert!(u32::try_from(quantity.max_valid()).is_ok());
+            }
         }
     }
 
     /// Each quantity at both ends of its range, and one resolution step outside.
     #[test]
     fn range_boundaries() {
-        let commands: [(&str, &Quantity); 6] = [
+        let commands: [(&str, &Quantity); 7] = [
             ("target force", &TARGET_FORCE),
             ("target coef", &TARGET_COEF),
             ("target reduction", &TARGET_REDUCTION),
+            ("target net-force", &TARGET_NET_FORCE),
             ("freq", &DRIVE_FREQ),
             ("cal normal", &CAL_LOAD),
             ("telemetry", &TELEMETRY_RATE),
@@ -233,12 +257,12 @@ mod tests {
                 let command = parse_command(&line).unwrap_or_else(|e| panic!("{line}: {e:?}"));
                 let scaled = match command {
                     Command::Target(target) => target.scaled_value(),
-                    Command::Freq { freq_chz } => freq_chz,
-                    Command::Cal { load_mn, .. } => load_mn,
-                    Command::Telemetry { rate_hz } => u32::from(rate_hz),
+                    Command::Freq { freq_chz } => i64::from(freq_chz),
+                    Command::Cal { load_mn, .. } => i64::from(load_mn),
+                    Command::Telemetry { rate_hz } => i64::from(rate_hz),
                     other => panic!("{line}: {other:?}"),
                 };
-                assert_eq!(i64::from(scaled), value, "{line}");
+                assert_eq!(scaled, value, "{line}");
             }
             for value in [quantity.min_valid() - 1, quantity.max_valid() + 1] {
                 let line = std::format!("{prefix} {}", text(value, quantity.decimals));
@@ -251,6 +275,10 @@ mod tests {
         assert!(parse_command("target reduction 0").is_ok());
         assert!(parse_command("target reduction 99.999").is_ok());
         assert_eq!(code("target reduction 100"), ErrorCode::OutOfRange);
+        assert!(parse_command("target net-force -50000").is_ok());
+        assert!(parse_command("target net-force 0").is_ok());
+        assert_eq!(code("target net-force -50000.001"), ErrorCode::OutOfRange);
+        assert_eq!(code("target net-force -99999999999"), ErrorCode::OutOfRange);
         assert!(parse_command("freq 20000").is_ok());
         assert!(parse_command("freq 60000").is_ok());
         assert_eq!(code("freq 19999.99"), ErrorCode::OutOfRange);

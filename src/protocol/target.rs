@@ -1,13 +1,14 @@
 //! The friction target: what the loop holds, in one of three ways.
 //!
 //! On the wire a target is written `kind:value` (`force:12.500`, `coef:0.350000`,
-//! `reduction:40.000`) in replies and telemetry, and `none` when no target is set. The value
-//! always has the full number of decimals of its quantity.
+//! `reduction:40.000`, `net-force:-5.000`) in replies and telemetry, and `none` when no target
+//! is set. The value always has the full number of decimals of its quantity; only the net
+//! force carries a sign.
 
 use heapless::string::StringView;
 
-use super::number::{NumberError, decode_u32};
-use super::quantity::{Quantity, TARGET_COEF, TARGET_FORCE, TARGET_REDUCTION};
+use super::number::{NumberError, decode_i32, decode_u32};
+use super::quantity::{Quantity, TARGET_COEF, TARGET_FORCE, TARGET_NET_FORCE, TARGET_REDUCTION};
 use super::text::{FormatError, put, put_fixed};
 
 /// The friction target (defined with the scene types, `sonolube-scene-types`, which the scene
@@ -33,21 +34,18 @@ impl TargetRange for Target {
             Target::Force { .. } => &TARGET_FORCE,
             Target::Coef { .. } => &TARGET_COEF,
             Target::Reduction { .. } => &TARGET_REDUCTION,
+            Target::NetForce { .. } => &TARGET_NET_FORCE,
         }
     }
 
     fn is_valid(&self) -> bool {
-        self.quantity().contains(i64::from(self.scaled_value()))
+        self.quantity().contains(self.scaled_value())
     }
 }
 
 /// Appends the value alone with all its decimals: `12.500`.
 pub(crate) fn write_value(target: &Target, out: &mut StringView) -> Result<(), FormatError> {
-    put_fixed(
-        out,
-        i64::from(target.scaled_value()),
-        target.quantity().decimals,
-    )
+    put_fixed(out, target.scaled_value(), target.quantity().decimals)
 }
 
 /// Appends `kind:value`, or [`NO_TARGET`].
@@ -71,7 +69,8 @@ pub(crate) fn write_target(
 pub enum TargetDecodeError {
     /// Neither `none` nor `kind:value` with a known kind.
     UnknownKind,
-    /// The value is not a number of the kind's resolution that fits a `u32`.
+    /// The value is not a number of the kind's resolution that fits the kind's field (`u32`,
+    /// or `i32` for the net force).
     BadValue(NumberError),
 }
 
@@ -81,13 +80,19 @@ pub fn decode_target(text: &str) -> Result<Option<Target>, TargetDecodeError> {
         return Ok(None);
     }
     let (kind, value) = text.split_once(':').ok_or(TargetDecodeError::UnknownKind)?;
-    // Learn the kind first (with a dummy value) to know how many decimals to read.
-    let decimals = Target::from_kind(kind, 0)
-        .ok_or(TargetDecodeError::UnknownKind)?
-        .quantity()
-        .decimals;
-    let scaled = decode_u32(value, decimals).map_err(TargetDecodeError::BadValue)?;
-    Ok(Target::from_kind(kind, scaled))
+    // Learn the kind first (with a dummy value) to know how many decimals and which sign.
+    let probe = Target::from_kind(kind, 0).ok_or(TargetDecodeError::UnknownKind)?;
+    let decimals = probe.quantity().decimals;
+    let scaled = if probe.is_signed() {
+        decode_i32(value, decimals).map(i64::from)
+    } else {
+        decode_u32(value, decimals).map(i64::from)
+    }
+    .map_err(TargetDecodeError::BadValue)?;
+    // The decoders bound the value to the kind's field: this cannot be `None`.
+    Target::from_kind(kind, scaled)
+        .map(Some)
+        .ok_or(TargetDecodeError::BadValue(NumberError::OutOfRange))
 }
 
 #[cfg(test)]
@@ -117,6 +122,14 @@ mod tests {
             })),
             "reduction:99.999"
         );
+        assert_eq!(
+            text(Some(&Target::NetForce { force_mn: -5_000 })),
+            "net-force:-5.000"
+        );
+        assert_eq!(
+            text(Some(&Target::NetForce { force_mn: 1 })),
+            "net-force:0.001"
+        );
         assert_eq!(text(None), "none");
     }
 
@@ -127,6 +140,9 @@ mod tests {
             Some(Target::Force { force_mn: u32::MAX }),
             Some(Target::Coef { coef_ppm: 0 }),
             Some(Target::Reduction { reduction_mpct: 1 }),
+            Some(Target::NetForce { force_mn: i32::MIN }),
+            Some(Target::NetForce { force_mn: i32::MAX }),
+            Some(Target::NetForce { force_mn: 0 }),
         ] {
             assert_eq!(decode_target(&text(target.as_ref())), Ok(target));
         }
@@ -138,6 +154,20 @@ mod tests {
         assert_eq!(
             decode_target("coef:0.0000001"),
             Err(TargetDecodeError::BadValue(NumberError::TooManyDecimals))
+        );
+        // A negative value is refused for the magnitude kinds, and beyond i32 for the net
+        // force: never wrapped.
+        assert_eq!(
+            decode_target("force:-1.000"),
+            Err(TargetDecodeError::BadValue(NumberError::OutOfRange))
+        );
+        assert_eq!(
+            decode_target("net-force:-2147483.649"),
+            Err(TargetDecodeError::BadValue(NumberError::OutOfRange))
+        );
+        assert_eq!(
+            decode_target("net-force:x"),
+            Err(TargetDecodeError::BadValue(NumberError::NotANumber))
         );
     }
 
@@ -161,6 +191,19 @@ mod tests {
         assert!(
             !Target::Reduction {
                 reduction_mpct: 100_000
+            }
+            .is_valid()
+        );
+        assert!(
+            Target::NetForce {
+                force_mn: -50_000_000
+            }
+            .is_valid()
+        );
+        assert!(Target::NetForce { force_mn: 0 }.is_valid());
+        assert!(
+            !Target::NetForce {
+                force_mn: 50_000_001
             }
             .is_valid()
         );

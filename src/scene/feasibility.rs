@@ -153,6 +153,7 @@ impl fmt::Display for Finding {
                     }
                     Target::Coef { coef_ppm } => ("coef", f64::from(coef_ppm) * 1e-6),
                     Target::Force { force_mn } => ("force_n", f64::from(force_mn) * 1e-3),
+                    Target::NetForce { force_mn } => ("net_force_n", f64::from(force_mn) * 1e-3),
                 };
                 write!(
                     f,
@@ -271,6 +272,8 @@ fn needed_ratio(target: Target, mu: f64, load_n: f64) -> f64 {
         Target::Reduction { reduction_mpct } => 1.0 - f64::from(reduction_mpct) * 1e-5,
         Target::Coef { coef_ppm } => f64::from(coef_ppm) * 1e-6 / mu,
         Target::Force { force_mn } => f64::from(force_mn) * 1e-3 / (mu * load_n),
+        // Never asked (skipped above); as a friction force, its magnitude.
+        Target::NetForce { force_mn } => f64::from(force_mn.unsigned_abs()) * 1e-3 / (mu * load_n),
     }
 }
 
@@ -380,7 +383,9 @@ fn reach<M: FrictionModel + ?Sized>(
             let Some(target) = target_at(scene.target, t as f32) else {
                 continue;
             };
-            if target == (Target::Reduction { reduction_mpct: 0 }) {
+            // A net-force target (issue 27) is not a friction ratio: its reach is the motor
+            // hold's, which flags it while running (`crate::control::net_force`).
+            if target == (Target::Reduction { reduction_mpct: 0 }) || target.is_signed() {
                 continue;
             }
             let speed = speed_at(scene, t);
@@ -424,6 +429,7 @@ fn reach<M: FrictionModel + ?Sized>(
                 Target::Reduction { .. } => "profiles.target.reduction_pct",
                 Target::Coef { .. } => "profiles.target.coef",
                 Target::Force { .. } => "profiles.target.force_n",
+                Target::NetForce { .. } => "profiles.target.net_force_n",
             };
             let finding = Finding {
                 severity,

@@ -46,8 +46,9 @@ pub fn target_at(points: &[TargetPoint], t_s: f32) -> Option<Target> {
     let from = current.target.scaled_value() as f32;
     let to = next.target.scaled_value() as f32;
     let value = libm::roundf(from + (to - from) * ((t_s - t_a) / (t_b - t_a)));
-    // Between two valid u32 values, so the conversion neither wraps nor saturates.
-    Target::from_kind(next.target.kind(), value as u32)
+    // Between two valid values of the kind's field, so the conversion neither wraps nor
+    // saturates.
+    Target::from_kind(next.target.kind(), value as i64)
 }
 
 #[cfg(test)]

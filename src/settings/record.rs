@@ -4,20 +4,26 @@
 //! A field that is `None` means "the scene's own": the scene's datasheet calibration, its drive
 //! frequency, no target, the board's default scene. [`Record::DEFAULTS`] is all `None`.
 //!
-//! # Encoding, version 1 (64 bytes, little-endian)
+//! # Encoding, versions 1 and 2 (64 bytes, little-endian)
+//!
+//! Version 2 adds the signed net-force target (issue 27): target kind 4, its value an `i32`
+//! in mN. A record is written with the lowest version that carries it (1 unless its target is
+//! a net force), so a firmware that knows only version 1 still reads every record it could
+//! have written, and refuses a net-force record as `other-version` instead of misreading it.
+//! Both versions are read; kind 4 in a version-1 record is `Invalid::Target`.
 //!
 //! | bytes | field |
 //! |---|---|
 //! | 0..4 | magic `SLST` |
-//! | 4 | version, 1 |
+//! | 4 | version, 1 or 2 |
 //! | 5 | presence flags: bit 0 scene, 1 normal calibration, 2 tangential calibration, 3 target, 4 drive frequency; bits 5-7 zero |
 //! | 6 | scene name length, 0 when absent, else 1..=24 |
-//! | 7 | target kind: 0 none, 1 force, 2 coef, 3 reduction |
+//! | 7 | target kind: 0 none, 1 force, 2 coef, 3 reduction, 4 net force (version 2) |
 //! | 8..32 | scene name, zero padded |
 //! | 32..40 | normal cell: offset (Q1.31 fraction of full scale, i32), span (Q16.16 N per full scale, i32) |
 //! | 40..48 | tangential cell: offset, span |
 //! | 48..52 | calibration counter, u32 |
-//! | 52..56 | target value, u32 scaled (mN, ppm, milli-percent) |
+//! | 52..56 | target value, u32 scaled (mN, ppm, milli-percent); i32 mN for the net force |
 //! | 56..60 | drive frequency, u32 cHz |
 //! | 60..64 | CRC-32 of bytes 0..60 |
 //!
@@ -29,8 +35,11 @@ use crate::protocol::{MAX_SCENE_NAME_LEN, SceneName, Target, TargetRange};
 
 /// Bytes of an encoded record.
 pub const RECORD_LEN: usize = 64;
-/// The record format's version.
-pub const RECORD_VERSION: u8 = 1;
+/// The record format's newest version (written for a net-force target; others are written as
+/// version 1, [`RECORD_VERSION_UNSIGNED`]).
+pub const RECORD_VERSION: u8 = 2;
+/// The first version: the three unsigned target kinds only.
+pub const RECORD_VERSION_UNSIGNED: u8 = 1;
 const RECORD_MAGIC: [u8; 4] = *b"SLST";
 
 /// Lowest and highest drive frequency that may be stored, cHz (the `freq` command's range).
@@ -173,7 +182,11 @@ impl Record {
     pub fn encode(&self) -> [u8; RECORD_LEN] {
         let mut out = [0u8; RECORD_LEN];
         out[0..4].copy_from_slice(&RECORD_MAGIC);
-        out[4] = RECORD_VERSION;
+        out[4] = if self.target.is_some_and(|target| target.is_signed()) {
+            RECORD_VERSION
+        } else {
+            RECORD_VERSION_UNSIGNED
+        };
         let mut flags = 0;
         if let Some(scene) = &self.scene {
             flags |= FLAG_SCENE;
@@ -199,8 +212,12 @@ impl Record {
                 Target::Force { .. } => 1,
                 Target::Coef { .. } => 2,
                 Target::Reduction { .. } => 3,
+                Target::NetForce { .. } => 4,
             };
-            out[52..56].copy_from_slice(&target.scaled_value().to_le_bytes());
+            // Valid values fit the field (u32, or i32 for the net force, two's complement);
+            // an invalid one is refused by `decode` either way.
+            let value = target.scaled_value() as u32;
+            out[52..56].copy_from_slice(&value.to_le_bytes());
         }
         if let Some(freq) = self.freq_chz {
             flags |= FLAG_FREQ;
@@ -219,8 +236,9 @@ impl Record {
         if bytes[0..4] != RECORD_MAGIC {
             return Err(Invalid::Magic);
         }
-        if bytes[4] != RECORD_VERSION {
-            return Err(Invalid::Version(bytes[4]));
+        let version = bytes[4];
+        if version != RECORD_VERSION && version != RECORD_VERSION_UNSIGNED {
+            return Err(Invalid::Version(version));
         }
         if crc32(&bytes[..60]) != u32_at(bytes, 60) {
             return Err(Invalid::Crc);
@@ -274,6 +292,9 @@ impl Record {
             (true, 2) => Some(Target::Coef { coef_ppm: value }),
             (true, 3) => Some(Target::Reduction {
                 reduction_mpct: value,
+            }),
+            (true, 4) if version >= RECORD_VERSION => Some(Target::NetForce {
+                force_mn: value as i32,
             }),
             (true, _) => return Err(Invalid::Target),
         };
@@ -349,6 +370,7 @@ pub(crate) mod tests {
             (1u32..=50_000_000).prop_map(|force_mn| Some(Target::Force { force_mn })),
             (1u32..=2_000_000).prop_map(|coef_ppm| Some(Target::Coef { coef_ppm })),
             (0u32..=99_999).prop_map(|reduction_mpct| Some(Target::Reduction { reduction_mpct })),
+            (-50_000_000i32..=50_000_000).prop_map(|force_mn| Some(Target::NetForce { force_mn })),
         ];
         let scene = prop_oneof![
             Just(None),
@@ -366,6 +388,44 @@ pub(crate) mod tests {
                 freq_chz,
             },
         )
+    }
+
+    /// A version-1 record as the firmware before the net-force target wrote it (bytes laid
+    /// out by hand from the version-1 table): still read, and written back identically.
+    #[test]
+    fn version_one_records_stay_loadable() {
+        let mut old = [0u8; RECORD_LEN];
+        old[0..4].copy_from_slice(b"SLST");
+        old[4] = 1;
+        old[5] = FLAG_SCENE | FLAG_TARGET;
+        old[6] = 9;
+        old[7] = 3; // reduction
+        old[8..17].copy_from_slice(b"reference");
+        old[52..56].copy_from_slice(&35_000u32.to_le_bytes());
+        let crc = crc32(&old[..60]);
+        old[60..64].copy_from_slice(&crc.to_le_bytes());
+        let record = Record::decode(&old, known).unwrap();
+        assert_eq!(
+            record.target,
+            Some(Target::Reduction {
+                reduction_mpct: 35_000
+            })
+        );
+        assert_eq!(record.scene, SceneName::new("reference"));
+        assert_eq!(record.encode(), old);
+        // The net force is written as version 2, with its sign; kind 4 under version 1 is
+        // a target the old format cannot hold.
+        let mut signed = record;
+        signed.target = Some(Target::NetForce { force_mn: -5_000 });
+        let bytes = signed.encode();
+        assert_eq!(bytes[4], RECORD_VERSION);
+        assert_eq!(bytes[7], 4);
+        assert_eq!(Record::decode(&bytes, known), Ok(signed));
+        let mut as_v1 = bytes;
+        as_v1[4] = RECORD_VERSION_UNSIGNED;
+        let crc = crc32(&as_v1[..60]);
+        as_v1[60..64].copy_from_slice(&crc.to_le_bytes());
+        assert_eq!(Record::decode(&as_v1, known), Err(Invalid::Target));
     }
 
     #[test]
@@ -389,8 +449,8 @@ pub(crate) mod tests {
         bad[0] = b'X';
         assert_eq!(Record::decode(&bad, known), Err(Invalid::Magic));
         let mut bad = good;
-        bad[4] = 2;
-        assert_eq!(Record::decode(&bad, known), Err(Invalid::Version(2)));
+        bad[4] = 3;
+        assert_eq!(Record::decode(&bad, known), Err(Invalid::Version(3)));
         let mut bad = good;
         bad[50] ^= 0x10;
         assert_eq!(Record::decode(&bad, known), Err(Invalid::Crc));
@@ -452,6 +512,13 @@ pub(crate) mod tests {
             Target::Reduction {
                 reduction_mpct: 99_999,
             },
+            Target::NetForce {
+                force_mn: -50_000_000,
+            },
+            Target::NetForce {
+                force_mn: 50_000_000,
+            },
+            Target::NetForce { force_mn: 0 },
         ] {
             record.target = Some(target);
             assert_eq!(Record::decode(&record.encode(), known), Ok(record));
@@ -462,6 +529,10 @@ pub(crate) mod tests {
             Target::Reduction {
                 reduction_mpct: 100_000,
             },
+            Target::NetForce {
+                force_mn: -50_000_001,
+            },
+            Target::NetForce { force_mn: i32::MIN },
         ] {
             record.target = Some(target);
             assert_eq!(

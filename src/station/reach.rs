@@ -165,6 +165,8 @@ pub(super) fn beyond_reach<M: FrictionModel + ?Sized>(
         Target::Reduction { reduction_mpct } => 1.0 - f64::from(reduction_mpct) * 1e-5,
         Target::Coef { coef_ppm } => f64::from(coef_ppm) * 1e-6 / mu0,
         Target::Force { force_mn } => f64::from(force_mn) * 1e-3 / (mu0 * load_n),
+        // A net force is not a friction ratio; the motor hold reports its own reach.
+        Target::NetForce { .. } => return None,
     };
     if needed >= reachable {
         return None;
@@ -177,7 +179,7 @@ pub(super) fn beyond_reach<M: FrictionModel + ?Sized>(
         Target::Coef { .. } => Target::Coef {
             coef_ppm: libm::ceil(reachable * mu0 * 1e6).min(2e6) as u32,
         },
-        Target::Force { .. } => Target::Force {
+        Target::Force { .. } | Target::NetForce { .. } => Target::Force {
             force_mn: libm::ceil(reachable * mu0 * load_n * 1e3).min(5e7) as u32,
         },
     })

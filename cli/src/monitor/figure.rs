@@ -25,6 +25,12 @@ pub fn telemetry_svg(title: &str, records: &[TelemetryRecord], band_pct: Option<
         Some(Target::Force { force_mn }) => f64::from(force_mn) * 1e-3,
         _ => f64::NAN,
     });
+    // The net force (issue 27) is the horn's force on the block; the tangential cell reads
+    // the block's drag on it, -F: drawn in the cell's sign so the two lines meet when held.
+    let net_force_target = column(&|r| match r.reading.target {
+        Some(Target::NetForce { force_mn }) => -f64::from(force_mn) * 1e-3,
+        _ => f64::NAN,
+    });
     let normal = column(&|r| f64::from(r.reading.normal_force_mn) * 1e-3);
     let tangential = column(&|r| f64::from(r.reading.tangential_force_mn) * 1e-3);
     let amplitude = column(&|r| f64::from(r.reading.drive_amplitude_ppm) * 1e-6);
@@ -46,6 +52,11 @@ pub fn telemetry_svg(title: &str, records: &[TelemetryRecord], band_pct: Option<
         .series(Series::line("tangential", &t, &tangential));
     if force_target.iter().any(|v| v.is_finite()) {
         forces = forces.series(Series::line("force target", &t, &force_target).dashed());
+    }
+    if net_force_target.iter().any(|v| v.is_finite()) {
+        forces = forces.series(
+            Series::line("net-force target (cell sign, -F)", &t, &net_force_target).dashed(),
+        );
     }
     let mut full_title = title.to_string();
     if reductions > 0 {
@@ -134,12 +145,15 @@ mod tests {
         assert!(telemetry_svg("", &[], None).contains("</svg>"));
         let force = Some(Target::Force { force_mn: 5_000 });
         let reduction = Some(Target::Reduction { reduction_mpct: 1 });
+        let net = Some(Target::NetForce { force_mn: -3_000 });
         let records = [
             record(1, SupervisorState::Running, force),
             record(2, SupervisorState::Running, reduction),
+            record(3, SupervisorState::Running, net),
         ];
         let svg = telemetry_svg("odd", &records, Some(3.0));
         assert!(svg.contains("force target"));
+        assert!(svg.contains("net-force target (cell sign, -F)"));
         assert!(svg.contains("1 records with a reduction target"));
     }
 }

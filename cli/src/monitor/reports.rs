@@ -183,7 +183,7 @@ pub fn target_text(target: Option<&Target>) -> String {
         Some(target) => format!(
             "{}:{}",
             target.kind(),
-            fixed(i64::from(target.scaled_value()), target.quantity().decimals)
+            fixed(target.scaled_value(), target.quantity().decimals)
         ),
     }
 }
@@ -220,6 +220,15 @@ mod tests {
         assert_eq!(status.reachable, Some(Target::Coef { coef_ppm: 180_000 }));
         assert_eq!(status.resonance, "near");
         assert!(status.extra_keys.is_empty());
+        // The signed kind (issue 27), and a malformed one named.
+        let line = "ok state=running scene=horn-motor target=net-force:-5.000 mu=0.151000 \
+                    normal_n=40.000 tangential_n=5.010 amp=0.523000 freq_hz=20000.00 overruns=0 \
+                    lost=0 fault=none lock=pinned phase_deg=undefined reach=ok reachable=none \
+                    resonance=near";
+        let status = decode_status(&reply(line)).unwrap();
+        assert_eq!(status.target, Some(Target::NetForce { force_mn: -5_000 }));
+        let error = decode_status(&reply(&line.replace("-5.000", "-5.0001"))).unwrap_err();
+        assert!(error.contains("target=net-force:-5.0001"), "{error}");
     }
 
     #[test]
@@ -272,6 +281,10 @@ mod tests {
                 reduction_mpct: 40_000
             })),
             "reduction:40.000"
+        );
+        assert_eq!(
+            target_text(Some(&Target::NetForce { force_mn: -5_250 })),
+            "net-force:-5.250"
         );
         assert_eq!(target_text(None), "none");
     }

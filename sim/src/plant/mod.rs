@@ -31,11 +31,13 @@ pub mod transducer;
 
 pub use contact::{Contact, ContactTruth};
 pub use dahl_state::DahlState;
+pub use motor_contact::{BlockOnHorn, MotorTruth};
 pub use noise::{Gaussian, Xoshiro128};
 pub use profile::{Scenario, ScenarioInputs};
 pub use sensors::LoadCellSim;
 pub use transducer::{CurrentPhasor, ResonantTransducer};
 
+use sonolube::model::motor::HornRegion;
 use sonolube::model::{AnyModel, FrictionModel, ModelError};
 use sonolube::protocol::Target;
 use sonolube::scene::{Channel, FaultKind, Scene};
@@ -84,6 +86,9 @@ pub struct GroundTruth {
     pub normal_fault: Option<FaultKind>,
     /// The fault acting on the tangential cell's sample, if any.
     pub tangential_fault: Option<FaultKind>,
+    /// The block on a horn (issue 27): its position and region, and the horn's net force on
+    /// it; `None` for a scene without the motor model.
+    pub motor: Option<MotorTruth>,
 }
 
 /// What the firmware reads at the end of a step, and the ground truth.
@@ -124,6 +129,9 @@ pub struct Plant<'a, M> {
     step: u32,
     last_contact: ContactTruth,
     initial_load_n: f32,
+    /// The block on the horn and the motor model at the plant's parameters (horn scenes whose
+    /// horn seed 001 Table 1 measured, `sonolube::model::motor::scene_motor`).
+    block: Option<BlockOnHorn>,
 }
 
 impl<'a> Plant<'a, AnyModel> {
@@ -165,6 +173,15 @@ impl<'a, M: FrictionModel> Plant<'a, M> {
         )
         .map_err(PlantError::Model)?;
         let initial = contact.evaluate(start.normal_load_n, start.sliding_velocity_m_per_s, 0.0);
+        let block = match sonolube::model::motor::scene_motor(scene, &scene.plant)
+            .map_err(PlantError::Model)?
+        {
+            Some((motor, regions)) => {
+                let start_m = scene.horn.map_or(0.0, |horn| horn.contact_position_m);
+                Some(BlockOnHorn::new(motor, regions, start_m).map_err(PlantError::Model)?)
+            }
+            None => None,
+        };
         let substep_s = (1.0 / (scene.control_rate_hz * f64::from(scene.plant_substeps))) as f32;
         Ok(Self {
             scenario,
@@ -187,6 +204,7 @@ impl<'a, M: FrictionModel> Plant<'a, M> {
             full_scale_amplitude_m: scene.actuator.full_scale_amplitude_m as f32,
             step: 0,
             last_contact: initial,
+            block,
         })
     }
 
@@ -254,6 +272,36 @@ impl<'a, M: FrictionModel> Plant<'a, M> {
                     amplitude,
                 )
             };
+            if let Some(block) = self.block.as_mut() {
+                // Off the face the block stays at the end (the rig would have lost it).
+                let _ = block.advance(inputs.sliding_velocity_m_per_s, substep_s as f32);
+                if block.region() != HornRegion::Transition {
+                    // A motor region (seed 001 Table 1): the horn drives the block; the cell
+                    // reads the block's drag on the horn, minus the horn's force on it.
+                    let motor = block.motor_force(
+                        inputs.normal_load_n.max(0.0),
+                        inputs.sliding_velocity_m_per_s,
+                        amplitude.clamp(0.0, 1.0),
+                    );
+                    let natural = self.last_contact.natural_friction_n;
+                    self.last_contact = match motor {
+                        Ok(motor) => ContactTruth {
+                            friction_n: -motor.force_n,
+                            natural_friction_n: natural,
+                            ratio: if natural > 0.0 {
+                                libm::fabsf(motor.force_n) / natural
+                            } else {
+                                1.0
+                            },
+                            error: None,
+                        },
+                        Err(error) => ContactTruth {
+                            error: Some(error),
+                            ..self.last_contact
+                        },
+                    };
+                }
+            }
             self.normal_cell.track(inputs.normal_load_n);
             self.tangential_cell.track(self.last_contact.friction_n);
         }
@@ -290,6 +338,12 @@ impl<'a, M: FrictionModel> Plant<'a, M> {
                 target: inputs.target,
                 normal_fault,
                 tangential_fault,
+                // The horn's force on the block, friction in the transition region.
+                motor: self.block.as_ref().map(|block| MotorTruth {
+                    position_m: block.position_m() as f32,
+                    region: block.region(),
+                    force_n: -self.last_contact.friction_n,
+                }),
             },
         }
     }

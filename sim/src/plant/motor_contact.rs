@@ -30,6 +30,7 @@ pub struct BlockOnHorn {
 
 /// The motor force at one instant (ground truth).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct MotorTruth {
     /// x from the horn centre, m.
     pub position_m: f32,

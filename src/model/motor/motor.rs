@@ -154,6 +154,42 @@ const TWO_OVER_PI_Q32: u64 = 2_734_261_102;
 const QUARTER_TURN: u64 = 1 << 30;
 const FULL_TURN: u64 = 1 << 32;
 
+/// The motor model of a horn scene's contact with `spec`'s parameters (mu, and R_q and lambda
+/// of its rough surface; the controller's spec for the station, the plant's for the simulated
+/// plant), with the scene's full-scale amplitude A, the horn's B and L and the drive
+/// frequency, the ellipse ([`UPhase::Quadrature`]), and Table 1's measured regions for the
+/// horn's material ([`MeasuredRegions::for_horn_modulus`]). `Ok(None)` for a scene without a
+/// horn, whose horn does not ask for the regions (`motor_regions`, false for a contact that
+/// stays put), without a rough surface, or whose horn Table 1 did not measure. Errors: the model's
+/// ([`MotorScene::new`]).
+pub fn scene_motor(
+    scene: &crate::scene::Scene<'_>,
+    spec: &crate::scene::ModelSpec,
+) -> Result<Option<(MotorScene, MeasuredRegions)>, ModelError> {
+    let (Some(horn), Some(surface)) = (scene.horn, spec.surface) else {
+        return Ok(None);
+    };
+    if !horn.motor_regions {
+        return Ok(None);
+    }
+    let Some(regions) = MeasuredRegions::for_horn_modulus(surface.young_1_pa) else {
+        return Ok(None);
+    };
+    let params = MotorParams {
+        friction_coefficient: spec.mu,
+        longitudinal_amplitude: scene.actuator.full_scale_amplitude_m,
+        vertical_amplitude: horn.vertical_amplitude_m,
+        horn_length: horn.length_m,
+        frequency: scene.transducer.drive_hz,
+        roughness_rq: surface.rq_m,
+        distribution_lambda: surface.distribution_lambda,
+    };
+    Ok(Some((
+        MotorScene::new(&params, UPhase::Quadrature)?,
+        regions,
+    )))
+}
+
 impl MotorScene {
     /// Builds the scene constants (f64, once per scene). Errors: non-finite inputs, mu outside
     /// (0, 2), negative amplitudes, L, f, R_q or lambda <= 0, lambda B / R_q > [`MAX_DECAY`],

@@ -28,6 +28,29 @@ pub const STAINLESS_HORN_REGIONS: MeasuredRegions = MeasuredRegions {
     motor_outer: (-1.5 * INCH, 1.5 * INCH),
 };
 
+/// Young's moduli of the two horns Table 1 measured (seed 000 Table 2: Al 73 GPa, SS 200 GPa),
+/// and how far a scene's horn may be from one to be taken as that horn: +-15 %, wider than the
+/// spread of the grades (Al alloys 69-79 GPa, stainless 190-203 GPa) and far from the other.
+const ALUMINIUM_YOUNG_PA: f64 = 73e9;
+const STAINLESS_YOUNG_PA: f64 = 200e9;
+const SAME_MATERIAL: f64 = 0.15;
+
+impl MeasuredRegions {
+    /// Table 1's regions for a horn of Young's modulus `young_pa` (body 1 of the scene's rough
+    /// surface): the aluminium horn's or the stainless-steel horn's. `None` for any other
+    /// material: Table 1 measured no regions for it, and they are not guessed.
+    pub fn for_horn_modulus(young_pa: f64) -> Option<Self> {
+        let near = |reference: f64| libm::fabs(young_pa / reference - 1.0) <= SAME_MATERIAL;
+        if near(ALUMINIUM_YOUNG_PA) {
+            Some(ALUMINIUM_HORN_REGIONS)
+        } else if near(STAINLESS_YOUNG_PA) {
+            Some(STAINLESS_HORN_REGIONS)
+        } else {
+            None
+        }
+    }
+}
+
 /// Which of seed 001's regions a position lies in, and so which model describes the block.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

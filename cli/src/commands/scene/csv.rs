@@ -58,13 +58,16 @@ pub fn csv(records: &[StepRecord]) -> String {
 /// `kind:value` with the protocol's decimals (`reduction:50.000`, `coef:0.380000`).
 fn target_text(target: &Target) -> String {
     let decimals = u32::from(target.quantity().decimals);
-    let scale = 10u32.pow(decimals);
+    let scale = 10u64.pow(decimals);
     let value = target.scaled_value();
-    let fraction = value % scale;
+    // Only the net force is signed (`net-force:-5.000`).
+    let sign = if value < 0 { "-" } else { "" };
+    let magnitude = value.unsigned_abs();
+    let fraction = magnitude % scale;
     format!(
-        "{}:{}.{fraction:0width$}",
+        "{}:{sign}{}.{fraction:0width$}",
         target.kind(),
-        value / scale,
+        magnitude / scale,
         width = decimals as usize
     )
 }
