@@ -41,8 +41,10 @@ use crate::variant::{Selection, select};
 
 mod commission;
 
-pub use commission::CommissionReport;
 use commission::CommissionState;
+pub use commission::{
+    CommissionReport, commissioned_settings, noise_standard_error_n, zero_standard_error_n,
+};
 mod reach;
 
 /// What a board gives the station each period.
@@ -245,7 +247,7 @@ impl Station {
             current_sense: false,
             no_current_reason: NO_CURRENT_ON_BOARD,
             applied: Amplitude::ZERO,
-            commission: CommissionState::Never,
+            commission: CommissionState::NEVER,
             reach: reach::ReachWatch::new(reach::ReachWatch::window_s(settings), settings.period_s),
             last_estimate: None,
             nominal_resonance_hz: scene.transducer.resonance_hz,
