@@ -19,7 +19,7 @@ use super::text::{FormatError, put, put_fixed, put_uint, put_word, write_line};
 /// its `count` is the number of names it gives). The longest other replies: `commission
 /// status` with every value at the widest its checks let through, 389 bytes
 /// (`protocol::commission` tests); a status with every field at its extreme and 32-byte scene
-/// and fault names and the reach fields, 373 bytes.
+/// and fault names, the reach fields and `values=commissioned`, 393 bytes.
 pub const REPLY_CAPACITY: usize = {
     let list = scene_list_len(&crate::scene::SCENE_NAMES);
     if list > 400 { list } else { 400 }
