@@ -24,10 +24,15 @@ use super::text::FormatError;
 use crate::commission::{CellZero, CommissionResult};
 use crate::station::{CommissionReport, noise_standard_error_n, zero_standard_error_n};
 
-/// `value` x 10^decimals rounded to an integer, `None` for a value that is not finite or
-/// does not fit (|scaled| < 9e15, exact in `f64`).
+/// Powers of ten for [`scaled`] (a table: `pow` in soft float costs more than a control
+/// period's budget on the QEMU board, where a command's reply is made inside a step).
+const POWERS_OF_TEN: [f64; 7] = [1.0, 10.0, 100.0, 1e3, 1e4, 1e5, 1e6];
+
+/// `value` x 10^decimals (at most 6) rounded to an integer, `None` for a value that is not
+/// finite or does not fit (|scaled| < 9e15, exact in `f64`).
 fn scaled(value: f64, decimals: u8) -> Option<i64> {
-    let scaled = libm::round(value * libm::pow(10.0, f64::from(decimals)));
+    let power = POWERS_OF_TEN.get(usize::from(decimals))?;
+    let scaled = libm::round(value * power);
     (scaled.is_finite() && libm::fabs(scaled) < 9.0e15).then_some(scaled as i64)
 }
 
