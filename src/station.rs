@@ -41,9 +41,11 @@ use crate::variant::{Selection, select};
 
 mod commission;
 
-pub use commission::CommissionReport;
 use commission::CommissionState;
 mod motor_hold;
+pub use commission::{
+    CommissionReport, commissioned_settings, noise_standard_error_n, zero_standard_error_n,
+};
 mod reach;
 
 /// What a board gives the station each period.
@@ -251,7 +253,7 @@ impl Station {
             current_sense: false,
             no_current_reason: NO_CURRENT_ON_BOARD,
             applied: Amplitude::ZERO,
-            commission: CommissionState::Never,
+            commission: CommissionState::NEVER,
             reach: reach::ReachWatch::new(reach::ReachWatch::window_s(settings), settings.period_s),
             last_estimate: None,
             nominal_resonance_hz: scene.transducer.resonance_hz,

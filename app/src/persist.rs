@@ -22,10 +22,12 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embedded_storage_async::nor_flash::NorFlash;
 use heapless::String;
+use sonolube::commission::CommissionResult;
 use sonolube::control::Reason;
 use sonolube::protocol::{Command, ProtocolError, REPLY_CAPACITY, SupervisorState};
 use sonolube::settings::{
-    Boot, Event, Invalid, Log, Record, Source, Store, format_log, format_settings,
+    Boot, CommissionedInvalid, Event, Invalid, Log, Record, Source, Store, format_log,
+    format_settings,
 };
 
 use crate::control::ControlLoop;
@@ -70,9 +72,17 @@ fn set_reply(write: impl FnOnce(&mut String<REPLY_CAPACITY>) -> bool) {
 pub trait Persistent {
     /// The settings of the loop as it runs (`cal_count` is filled in by [`Persisted`]).
     fn capture(&self) -> Record;
+    /// The commissioned values the loop runs on (`None`: the scene's declared ones), saved
+    /// beside the record.
+    fn commissioned(&self) -> Option<CommissionResult>;
     /// Puts `record` into the loop (its scene, calibrations, drive frequency, target; fields
-    /// at `None` the scene's own), whole or not at all.
-    fn apply(&mut self, record: &Record) -> Result<(), ProtocolError>;
+    /// at `None` the scene's own) and the `commissioned` values saved with it
+    /// ([`sonolube::settings::apply`]; `None`: the declared values), whole or not at all.
+    fn apply(
+        &mut self,
+        record: &Record,
+        commissioned: Option<&CommissionResult>,
+    ) -> Result<(), ProtocolError>;
     /// The supervisor's state.
     fn state(&self) -> SupervisorState;
     /// The latched fault, if any.
@@ -81,6 +91,21 @@ pub trait Persistent {
     /// `none`.
     fn commission(&self) -> sonolube::station::CommissionReport {
         sonolube::station::CommissionReport::Never
+    }
+}
+
+/// Logs why a stored commissioning is not used.
+fn warn_commissioning(why: CommissionedInvalid) {
+    match why {
+        CommissionedInvalid::Range { step, reason } => defmt::warn!(
+            "settings: stored commissioning not usable: {=str} ({=str} step): declared values",
+            reason,
+            step.name()
+        ),
+        _ => defmt::warn!(
+            "settings: stored commissioning not usable ({=str}): declared values",
+            why.reason()
+        ),
     }
 }
 
@@ -124,9 +149,26 @@ impl<L: ControlLoop + Persistent, F: NorFlash> Persisted<L, F> {
                 }
                 let mut source = booted.source;
                 let mut cal_count = booted.record.cal_count;
-                if source == Source::Stored && inner.apply(&booted.record).is_err() {
-                    source = Source::Defaults(Invalid::Refused);
-                    cal_count = 0;
+                let commissioned = match booted.commissioned {
+                    Ok(commissioned) => commissioned,
+                    Err(why) => {
+                        warn_commissioning(why);
+                        None
+                    }
+                };
+                if source == Source::Stored
+                    && inner.apply(&booted.record, commissioned.as_ref()).is_err()
+                {
+                    // The settings without the commissioning, else the defaults.
+                    let alone = commissioned.is_some() && inner.apply(&booted.record, None).is_ok();
+                    if alone {
+                        defmt::warn!(
+                            "settings: the stored commissioning was refused: declared values"
+                        );
+                    } else {
+                        source = Source::Defaults(Invalid::Refused);
+                        cal_count = 0;
+                    }
                 }
                 Self {
                     inner,
@@ -212,12 +254,19 @@ impl<L: ControlLoop + Persistent, F: NorFlash> Persisted<L, F> {
                 self.require_drive_off(command)?;
                 let mut record = self.inner.capture();
                 record.cal_count = self.cal_count;
-                block_on(self.store()?.save(&record)).map_err(|error| {
+                let failed = |error: sonolube::settings::StoreError| {
                     defmt::error!("settings: save failed ({=str})", error.name());
                     ProtocolError::StorageFailed {
                         reason: error.name(),
                     }
-                })?;
+                };
+                // The record first: a cut before the commissioning is written leaves the
+                // record with no commissioning of its own (the declared values).
+                block_on(self.store()?.save(&record)).map_err(failed)?;
+                if let Some(result) = self.inner.commissioned() {
+                    block_on(self.store()?.save_commissioned(&result, &record)).map_err(failed)?;
+                    defmt::info!("settings: saved the commissioned values {}", result);
+                }
                 defmt::info!("settings: saved {}", record);
                 set_reply(|out| format_settings("saved", &record, out.as_mut_view()).is_ok());
                 Ok(())
@@ -233,7 +282,21 @@ impl<L: ControlLoop + Persistent, F: NorFlash> Persisted<L, F> {
                         reason: why.reason(),
                     },
                 })?;
-                self.inner.apply(&record)?;
+                // A damaged commissioning refuses the whole `load` with its reason; one saved
+                // with other settings is not theirs (the declared values).
+                let commissioned =
+                    block_on(self.store()?.load_commissioned(&record)).map_err(|why| {
+                        warn_commissioning(why);
+                        match why {
+                            CommissionedInvalid::Storage => ProtocolError::StorageFailed {
+                                reason: why.reason(),
+                            },
+                            _ => ProtocolError::SettingsInvalid {
+                                reason: why.reason(),
+                            },
+                        }
+                    })?;
+                self.inner.apply(&record, commissioned.as_ref())?;
                 self.cal_count = record.cal_count;
                 defmt::info!("settings: loaded {}", record);
                 set_reply(|out| format_settings("loaded", &record, out.as_mut_view()).is_ok());
@@ -241,7 +304,7 @@ impl<L: ControlLoop + Persistent, F: NorFlash> Persisted<L, F> {
             }
             Command::Defaults => {
                 self.require_drive_off(command)?;
-                self.inner.apply(&Record::DEFAULTS)?;
+                self.inner.apply(&Record::DEFAULTS, None)?;
                 self.cal_count = 0;
                 set_reply(|out| {
                     format_settings("defaults", &Record::DEFAULTS, out.as_mut_view()).is_ok()

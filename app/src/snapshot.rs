@@ -26,6 +26,9 @@ pub struct Snapshot {
     pub motional: Option<sonolube::resonance::Phasor>,
     /// Whether the target is within reach, and the drive near the resonance (issue 26).
     pub reach: RunReach,
+    /// The loop runs on commissioned values, not the scene's declared ones (`status`'s
+    /// `values=`).
+    pub commissioned: bool,
 }
 
 impl Snapshot {
@@ -39,6 +42,7 @@ impl Snapshot {
         lock: None,
         motional: None,
         reach: RunReach::UNKNOWN,
+        commissioned: false,
     };
 
     /// The snapshot of a controller `output`, with the loop's other facts.
@@ -67,6 +71,16 @@ impl Snapshot {
             lock: None,
             motional: None,
             reach: RunReach::UNKNOWN,
+            commissioned: false,
+        }
+    }
+
+    /// This snapshot with whether the station runs on commissioned values
+    /// (`sonolube::station::Station::commissioned`).
+    pub fn with_commissioned(self, commissioned: bool) -> Self {
+        Snapshot {
+            commissioned,
+            ..self
         }
     }
 
@@ -96,6 +110,7 @@ impl Snapshot {
             lock: self.lock.map(Lock::name),
             phase_mdeg: self.phase_mdeg(),
             reach: self.reach,
+            commissioned: self.commissioned,
         }
     }
 

@@ -216,6 +216,7 @@ impl Firmware {
                     lock: Some("pinned"),
                     phase_mdeg: None,
                     reach: sonolube::protocol::RunReach::UNKNOWN,
+                    commissioned: false,
                 },
                 out,
             ),

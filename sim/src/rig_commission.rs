@@ -41,7 +41,9 @@ pub fn start_rig_commission(rig: &mut ClosedLoop<'_>) -> Result<(), SimError> {
 /// How the commissioning on `rig` ended: `None` while it runs.
 pub fn rig_commission_outcome(rig: &ClosedLoop<'_>) -> Option<Result<CommissionResult, SimError>> {
     match rig.station().commission_report() {
-        CommissionReport::Running(_) | CommissionReport::Never => None,
+        CommissionReport::Running(_) | CommissionReport::Never | CommissionReport::Restored(_) => {
+            None
+        }
         CommissionReport::Done(result) => Some(Ok(result)),
         CommissionReport::Refused(refusal) => {
             Some(Err(SimError::Commission(refusal.step, refusal.reason)))
@@ -119,6 +121,78 @@ mod tests {
                 "{name} mu0 {result:?} tolerance {tolerance}"
             );
         }
+    }
+}
+
+#[cfg(test)]
+mod console {
+    use super::*;
+    use sonolube::control::{Config, tuned};
+    use sonolube::fx::Q2_30;
+    use sonolube::scene::find;
+
+    /// The console's `commission` (the station's own path, not a scene's `commission = true`)
+    /// puts every value it measured into the loop: the envelope's time constant, f0 (drive
+    /// and current ceiling), mu0 (the natural coefficient's prior, the estimate restarted
+    /// there, the contact's relaxation lag scaled with it), both cells' measured noise, and
+    /// the gains by the tuning rule on all of them. Each assertion fails when its value is
+    /// dropped from `commissioned_settings` or `apply_commission`.
+    #[test]
+    fn a_console_commission_runs_the_loop_on_every_measured_value() {
+        let scene = find("resonance-search").expect("built in");
+        let mut rig = ClosedLoop::operated(&rig_scene(scene)).expect("operated");
+        let declared = *rig.station().settings();
+        assert_eq!(rig.station().commissioned(), None);
+        start_rig_commission(&mut rig).expect("started");
+        let limit = libm::ceil(RIG_LIMIT_S * scene.control_rate_hz) as u32;
+        let mut outcome = None;
+        for _ in 0..limit {
+            rig.step();
+            outcome = rig_commission_outcome(&rig);
+            if outcome.is_some() {
+                break;
+            }
+        }
+        let result = outcome.expect("ended").expect("accepted");
+        let station = rig.station();
+        let s = *station.settings();
+        assert_eq!(station.commissioned(), Some(result));
+        assert_eq!(s.envelope_time_constant_s, result.time_constant_s.value);
+        assert_eq!(s.actuator.drive_frequency_hz, result.resonance_hz.value);
+        let chz = libm::round(result.resonance_hz.value * 100.0) as u32;
+        assert!(
+            station.drive_freq_chz().abs_diff(chz) <= 1,
+            "{}",
+            station.drive_freq_chz()
+        );
+        // mu0: the prior, the estimate restarted at it, the contact's lag scaled with it.
+        let mu0 = result.natural_coefficient.value;
+        assert_eq!(s.natural_prior, mu0);
+        assert_ne!(declared.natural_prior, mu0);
+        let natural = station.controller().natural_coefficient();
+        assert_eq!(
+            natural,
+            Q2_30::from_f64(mu0).expect("in range"),
+            "{natural:?}"
+        );
+        assert_eq!(
+            s.contact_lag_s,
+            declared.contact_lag_s * (mu0 / declared.natural_prior)
+        );
+        // The cells' noise as their tare measured it (the simulated rig tares both).
+        let normal_noise = result.normal.noise_rms_n.expect("normal cell tared");
+        let tangential_noise = result
+            .tangential
+            .noise_rms_n
+            .expect("tangential cell tared");
+        assert_eq!(s.normal_noise_n, normal_noise);
+        assert_eq!(s.tangential_noise_n, tangential_noise);
+        // The gains by the rule on these values, and the controller running them.
+        assert_eq!(tuned(&s), Ok(s));
+        assert_eq!(
+            station.controller().config(),
+            &Config::new(&s).expect("accepted")
+        );
     }
 }
 

@@ -128,29 +128,105 @@ impl Refusal {
     }
 }
 
-/// Checks each result against its physical range: f0 in the drive band, Q in
-/// [`QUALITY_RANGE`], mu0 in (0, 2], and every value and error finite.
+/// Largest cell zero and noise accepted, N: what a Q16.16 newton reading holds.
+pub const CELL_RANGE_N: f64 = 32_768.0;
+
+/// Checks each result against its physical range, and names the first that is not in it:
+/// f0 in the drive band [`RESONANCE_RANGE_HZ`]; Q in [`QUALITY_RANGE`] and equal to
+/// `pi f0 tau` (to 1e-9: the sequence computes it so, and a stored result must agree); mu0 in
+/// (0, 2] ([`NATURAL_RANGE`]); each standard error in [0, the width of its value's range] (an
+/// error wider than the range measured nothing); at least [`MIN_RING_DOWN_POINTS`] ring-down
+/// points; each cell's zero and noise within [`CELL_RANGE_N`], the noise not negative. NaN
+/// and infinities fail every range.
+///
+/// [`MIN_RING_DOWN_POINTS`]: crate::resonance::MIN_RING_DOWN_POINTS
 pub fn check(result: &CommissionResult) -> Result<(), Refusal> {
-    let finite = |m: &Measured| m.value.is_finite() && m.standard_error.is_finite();
+    let within = |x: f64, (lo, hi): (f64, f64)| x >= lo && x <= hi;
     let f0 = result.resonance_hz;
-    if !finite(&f0) || f0.value < RESONANCE_RANGE_HZ.0 || f0.value > RESONANCE_RANGE_HZ.1 {
+    let band = RESONANCE_RANGE_HZ;
+    if !within(f0.value, band) {
         return Err(Refusal::new(
             Step::Resonance,
             "f0 outside the drive band 20-60 kHz",
             f0.value,
         ));
     }
+    if !within(f0.standard_error, (0.0, band.1 - band.0)) {
+        return Err(Refusal::new(
+            Step::Resonance,
+            "f0 error outside [0, 40 kHz]",
+            f0.standard_error,
+        ));
+    }
     let q = result.quality_factor;
-    if !finite(&q)
-        || !finite(&result.time_constant_s)
-        || q.value < QUALITY_RANGE.0
-        || q.value > QUALITY_RANGE.1
-    {
+    if !within(q.value, QUALITY_RANGE) {
         return Err(Refusal::new(Step::RingDown, "Q outside [5, 5000]", q.value));
     }
+    if !within(q.standard_error, (0.0, QUALITY_RANGE.1)) {
+        return Err(Refusal::new(
+            Step::RingDown,
+            "Q error outside [0, 5000]",
+            q.standard_error,
+        ));
+    }
+    let tau = result.time_constant_s;
+    let q_of_tau = core::f64::consts::PI * f0.value * tau.value;
+    // NaN (a tau that is not finite) compares false: refused.
+    let agrees = libm::fabs(q_of_tau - q.value) <= 1e-9 * q.value;
+    if !agrees {
+        return Err(Refusal::new(
+            Step::RingDown,
+            "Q is not pi f0 tau",
+            tau.value,
+        ));
+    }
+    let tau_max = QUALITY_RANGE.1 / (core::f64::consts::PI * band.0);
+    if !within(tau.standard_error, (0.0, tau_max)) {
+        return Err(Refusal::new(
+            Step::RingDown,
+            "tau error outside [0, 80 ms]",
+            tau.standard_error,
+        ));
+    }
+    if (result.ring_down_points as usize) < crate::resonance::MIN_RING_DOWN_POINTS {
+        return Err(Refusal::new(
+            Step::RingDown,
+            "ring-down too short",
+            f64::from(result.ring_down_points),
+        ));
+    }
     let mu0 = result.natural_coefficient;
-    if !finite(&mu0) || mu0.value <= NATURAL_RANGE.0 || mu0.value > NATURAL_RANGE.1 {
+    if !(mu0.value > NATURAL_RANGE.0 && mu0.value <= NATURAL_RANGE.1) {
         return Err(Refusal::new(Step::Natural, "mu0 outside (0, 2]", mu0.value));
+    }
+    if !within(mu0.standard_error, (0.0, NATURAL_RANGE.1)) {
+        return Err(Refusal::new(
+            Step::Natural,
+            "mu0 error outside [0, 2]",
+            mu0.standard_error,
+        ));
+    }
+    // The zeros are read when the sequence starts, before its first step.
+    for (cell, zero_reason, noise_reason) in [
+        (
+            &result.normal,
+            "normal zero outside +-32768 N",
+            "normal noise outside [0, 32768 N]",
+        ),
+        (
+            &result.tangential,
+            "tangential zero outside +-32768 N",
+            "tangential noise outside [0, 32768 N]",
+        ),
+    ] {
+        if !within(cell.zero_n, (-CELL_RANGE_N, CELL_RANGE_N)) {
+            return Err(Refusal::new(Step::Resonance, zero_reason, cell.zero_n));
+        }
+        if let Some(noise) = cell.noise_rms_n
+            && !within(noise, (0.0, CELL_RANGE_N))
+        {
+            return Err(Refusal::new(Step::Resonance, noise_reason, noise));
+        }
     }
     Ok(())
 }

@@ -36,8 +36,8 @@
 //!
 //! | command | argument range and resolution | effect | `ok` reply (example) |
 //! |---|---|---|---|
-//! | `version` | | firmware and protocol version | `ok firmware=0.1.0 board=qemu protocol=2` |
-//! | `status` | | state, target and measurements | `ok state=running scene=demo target=force:12.500 mu=0.312000 normal_n=40.000 tangential_n=12.480 amp=0.523000 freq_hz=40000.00 overruns=0 lost=0 fault=none lock=none phase_deg=undefined reach=ok reachable=none resonance=near` |
+//! | `version` | | firmware and protocol version | `ok firmware=0.1.0 board=qemu protocol=3` |
+//! | `status` | | state, target and measurements | `ok state=running scene=demo target=force:12.500 mu=0.312000 normal_n=40.000 tangential_n=12.480 amp=0.523000 freq_hz=40000.00 overruns=0 lost=0 fault=none lock=none phase_deg=undefined reach=ok reachable=none resonance=near values=declared` (`values=commissioned` when the loop runs on commissioned values, protocol 3) |
 //! | `faults` | | latched and active faults | `ok latched=overcurrent active=none` |
 //! | `target force <N>` | `0 < N <= 50000` newtons, 0.001 N | hold this friction force | `ok target=force:12.500` |
 //! | `target coef <mu>` | `0 < mu <= 2`, 0.000001 | hold this friction coefficient | `ok target=coef:0.350000` |
@@ -215,4 +215,4 @@ pub use text::{FormatError, MAX_DECIMALS, MAX_WORD_LEN, is_word};
 /// Version of this protocol, reported by `version`. Bumped when a line that one side sends
 /// could be read differently by the other (a new field, state or keyword); new error codes and
 /// commands that old hosts never send do not bump it.
-pub const PROTOCOL_VERSION: u16 = 2;
+pub const PROTOCOL_VERSION: u16 = 3;

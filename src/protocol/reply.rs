@@ -14,13 +14,15 @@ use super::quantity::{CAL_LOAD, DRIVE_FREQ};
 use super::target::{Target, write_target};
 use super::text::{FormatError, put, put_fixed, put_uint, put_word, write_line};
 
-/// Buffer size (bytes) that holds every reply: the longest of 384 bytes and the `scene list`
+/// Buffer size (bytes) that holds every reply: the longest of 400 bytes and the `scene list`
 /// reply of every compiled scene ([`crate::scene::SCENE_NAMES`]: the list is never cut, and
-/// its `count` is the number of names it gives). The longest other reply, a status with every
-/// field at its extreme and 32-byte scene and fault names and the reach fields, is 373 bytes.
+/// its `count` is the number of names it gives). The longest other replies: `commission
+/// status` with every value at the widest its checks let through, 389 bytes
+/// (`protocol::commission` tests); a status with every field at its extreme and 32-byte scene
+/// and fault names, the reach fields and `values=commissioned`, 393 bytes.
 pub const REPLY_CAPACITY: usize = {
     let list = scene_list_len(&crate::scene::SCENE_NAMES);
-    if list > 384 { list } else { 384 }
+    if list > 400 { list } else { 400 }
 };
 
 /// Bytes of the `scene list` reply for `names`: `ok count=N scenes=a,b,c\n` (`none` for no

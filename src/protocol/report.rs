@@ -33,6 +33,9 @@ pub struct StatusReport {
     pub phase_mdeg: Option<i32>,
     /// Whether the target is within reach, and the drive near the resonance.
     pub reach: super::RunReach,
+    /// The loop runs on commissioned values (`values=commissioned`: a `commission`'s, or
+    /// restored by `load`) instead of the scene's declared ones (`values=declared`).
+    pub commissioned: bool,
 }
 
 /// The data of a `faults` reply: names (words other than `none`) of faults.
@@ -59,7 +62,8 @@ pub struct VersionReport {
 
 /// Writes the `status` reply:
 /// `ok state= scene= target= mu= normal_n= tangential_n= amp= freq_hz= overruns= lost= fault=
-/// lock= phase_deg=` (`phase_deg=undefined` when no phase was measured).
+/// lock= phase_deg= reach= reachable= resonance= values=` (`phase_deg=undefined` when no phase
+/// was measured; `values=commissioned|declared`, protocol 3).
 pub fn format_status(report: &StatusReport, out: &mut StringView) -> Result<(), FormatError> {
     let reply = OkReply::new(out)
         .word("state", report.reading.state.name())
@@ -91,6 +95,14 @@ pub fn format_status(report: &StatusReport, out: &mut StringView) -> Result<(), 
                 .reach
                 .resonance
                 .map_or(super::reach::UNKNOWN_WORD, super::ResonanceDistance::name),
+        )
+        .word(
+            "values",
+            if report.commissioned {
+                "commissioned"
+            } else {
+                "declared"
+            },
         )
         .finish()
 }
@@ -178,6 +190,7 @@ mod tests {
             lock: Some("locked"),
             phase_mdeg: Some(-1_234),
             reach: crate::protocol::RunReach::UNKNOWN,
+            commissioned: false,
         }
     }
 
@@ -189,18 +202,23 @@ mod tests {
             out,
             "ok state=running scene=demo target=force:12.500 mu=0.312000 normal_n=40.000 \
              tangential_n=12.480 amp=0.523000 freq_hz=40000.00 overruns=0 lost=0 fault=none \
-             lock=locked phase_deg=-1.234 reach=ok reachable=none resonance=unknown\n"
+             lock=locked phase_deg=-1.234 reach=ok reachable=none resonance=unknown \
+             values=declared\n"
         );
         let Ok(Reply::Ok(payload)) = parse_reply(&out) else {
             panic!("{out}")
         };
         assert_eq!(payload.get("tangential_n"), Some("12.480"));
-        assert_eq!(payload.pairs().count(), 16);
+        assert_eq!(payload.pairs().count(), 17);
         let mut undefined = status_example();
         undefined.phase_mdeg = None;
         undefined.lock = None;
         format_status(&undefined, &mut out).unwrap();
         assert!(out.contains(" lock=none phase_deg=undefined "), "{out}");
+        let mut commissioned = status_example();
+        commissioned.commissioned = true;
+        format_status(&commissioned, &mut out).unwrap();
+        assert!(out.ends_with(" values=commissioned\n"), "{out}");
     }
 
     #[test]
@@ -233,10 +251,11 @@ mod tests {
                 }),
                 resonance: Some(crate::protocol::ResonanceDistance::Near),
             },
+            commissioned: true,
         };
         let mut out = Line::new();
         format_status(&report, &mut out).unwrap();
-        assert_eq!(out.len(), 373, "{out}");
+        assert_eq!(out.len(), 393, "{out}");
     }
 
     #[test]
@@ -267,7 +286,7 @@ mod tests {
             protocol: crate::protocol::PROTOCOL_VERSION,
         };
         format_version(&version, &mut out).unwrap();
-        assert_eq!(out, "ok firmware=0.1.0 board=qemu protocol=2\n");
+        assert_eq!(out, "ok firmware=0.1.0 board=qemu protocol=3\n");
 
         format_scene_list(&["demo", "ramp"], &mut out).unwrap();
         assert_eq!(out, "ok count=2 scenes=demo,ramp\n");
@@ -275,7 +294,11 @@ mod tests {
         assert_eq!(out, "ok count=0 scenes=none\n");
         // A list that does not fit is refused whole, never cut.
         let name = "n".repeat(24);
-        let fits = (REPLY_CAPACITY - 28) / 25;
+        // "ok count=" N " scenes=" then 24-byte names and commas, "\n": 17 + digits + 25 n.
+        let fits = (1..)
+            .take_while(|&n: &usize| 17 + n.to_string().len() + 25 * n <= REPLY_CAPACITY)
+            .last()
+            .expect("one name fits");
         let names: Vec<&str> = (0..=fits).map(|_| name.as_str()).collect();
         format_scene_list(&names[..fits], &mut out).unwrap();
         assert_eq!(

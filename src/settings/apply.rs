@@ -2,6 +2,7 @@
 //! a record into one, whole or not at all.
 
 use super::record::{AxisCal, Record};
+use crate::commission::CommissionResult;
 use crate::fx::{Q1_31, Q16_16};
 use crate::protocol::{Axis, Command, ProtocolError};
 use crate::sense::Calibration;
@@ -39,8 +40,14 @@ impl CellBench for NoBench {
 
 /// Puts `record`'s calibrations, drive frequency and target into `station`, which the caller
 /// has just built for the record's scene (so its fields at `None` are already the scene's
-/// own). All or nothing: on an error `station` is unchanged.
-pub fn apply(station: &mut Station, record: &Record) -> Result<(), ProtocolError> {
+/// own), then the `commissioned` values saved with it
+/// ([`Station::apply_commissioned`]: the loop runs on them, f0 replacing the record's drive
+/// frequency). All or nothing: on an error `station` is unchanged.
+pub fn apply(
+    station: &mut Station,
+    record: &Record,
+    commissioned: Option<&CommissionResult>,
+) -> Result<(), ProtocolError> {
     let mut next = station.clone();
     let (normal, tangential) = next.channels_mut();
     for (channel, cal) in [(normal, record.normal), (tangential, record.tangential)] {
@@ -53,6 +60,12 @@ pub fn apply(station: &mut Station, record: &Record) -> Result<(), ProtocolError
     }
     if let Some(freq_chz) = record.freq_chz {
         next.execute(&Command::Freq { freq_chz }, &mut NoBench)?;
+    }
+    if let Some(result) = commissioned {
+        next.apply_commissioned(result)
+            .map_err(|_| ProtocolError::SettingsInvalid {
+                reason: "commissioning-refused-by-controller",
+            })?;
     }
     if let Some(target) = record.target {
         next.execute(&Command::Target(target), &mut NoBench)?;

@@ -1,5 +1,6 @@
 //! The settings store: a [`sequential_storage`] map over any `NorFlash` (async), holding the
-//! settings [`Record`] under key 1 and the boot and fault [`Log`] under key 2.
+//! settings [`Record`] under key 1, the boot and fault [`Log`] under key 2 and the
+//! commissioned values (`super::commissioned`) under key 3.
 //!
 //! The map appends each new version of an item after the previous ones and only erases a page
 //! after the newest items have been copied out of it, so the writes are spread over all the
@@ -14,11 +15,16 @@ use embedded_storage_async::nor_flash::NorFlash;
 use sequential_storage::cache::{Cache, Uncached};
 use sequential_storage::map::{MapConfig, MapStorage};
 
+use super::commissioned::{
+    COMMISSIONED_LEN, CommissionedInvalid, decode_commissioned, encode_commissioned,
+};
 use super::log::{LOG_BYTES, Log};
 use super::record::{Invalid, RECORD_LEN, Record};
+use crate::commission::CommissionResult;
 
 const KEY_RECORD: u8 = 1;
 const KEY_LOG: u8 = 2;
+const KEY_COMMISSIONED: u8 = 3;
 
 /// Buffer for one item (key and value), rounded up to the largest flash word (32 bytes) and
 /// aligned for drivers that need it.
@@ -136,6 +142,33 @@ impl<F: NorFlash> Store<F> {
         self.store(KEY_RECORD, &record.encode()).await
     }
 
+    /// Stores `result` as the commissioning saved with `record` (call after saving `record`:
+    /// a power cut between the two leaves a commissioning linked to other settings, which is
+    /// not used).
+    pub async fn save_commissioned(
+        &mut self,
+        result: &CommissionResult,
+        record: &Record,
+    ) -> Result<(), StoreError> {
+        self.store(KEY_COMMISSIONED, &encode_commissioned(result, record))
+            .await
+    }
+
+    /// The stored commissioning for the settings `record` ([`decode_commissioned`]): `None`
+    /// when there is none or it was saved with other settings.
+    pub async fn load_commissioned(
+        &mut self,
+        record: &Record,
+    ) -> Result<Option<CommissionResult>, CommissionedInvalid> {
+        let mut bytes = [0u8; COMMISSIONED_LEN + 1];
+        match self.fetch(KEY_COMMISSIONED, &mut bytes).await {
+            Ok(len) => decode_commissioned(&bytes[..len], record),
+            Err(Invalid::Empty) => Ok(None),
+            Err(Invalid::Length) => Err(CommissionedInvalid::Length),
+            Err(_) => Err(CommissionedInvalid::Storage),
+        }
+    }
+
     /// Stores `log` as the newest log.
     pub async fn save_log(&mut self, log: &Log) -> Result<(), StoreError> {
         self.store(KEY_LOG, &log.encode()).await
@@ -163,13 +196,17 @@ impl Source {
 }
 
 /// What a boot found and did.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Boot {
     /// The settings to run with.
     pub record: Record,
     /// Where they came from.
     pub source: Source,
+    /// The commissioned values saved with the stored settings (`Ok(None)`: none, or the
+    /// settings are the defaults), or why they are not used (the loop then runs on the
+    /// declared values).
+    pub commissioned: Result<Option<CommissionResult>, CommissionedInvalid>,
     /// The log, with this boot counted.
     pub log: Log,
     /// Why the stored log was not used (a fresh one was started), if it was not.
@@ -179,7 +216,7 @@ pub struct Boot {
 }
 
 /// The boot sequence: loads and checks the settings (the defaults, with the reason, when they
-/// are missing or invalid), loads the log, counts this boot (and the watchdog reset that caused
+/// are missing or invalid) and the commissioning saved with them, loads the log, counts this boot (and the watchdog reset that caused
 /// it) and writes the log back.
 pub async fn boot<F: NorFlash>(
     store: &mut Store<F>,
@@ -189,6 +226,10 @@ pub async fn boot<F: NorFlash>(
     let (record, source) = match store.load(known_scene).await {
         Ok(record) => (record, Source::Stored),
         Err(why) => (Record::DEFAULTS, Source::Defaults(why)),
+    };
+    let commissioned = match source {
+        Source::Stored => store.load_commissioned(&record).await,
+        Source::Defaults(_) => Ok(None),
     };
     let (mut log, log_invalid) = match store.load_log().await {
         Ok(log) => (log, None),
@@ -200,6 +241,7 @@ pub async fn boot<F: NorFlash>(
     Boot {
         record,
         source,
+        commissioned,
         log,
         log_invalid,
         log_write,

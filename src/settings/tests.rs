@@ -295,7 +295,7 @@ fn capture_returns_what_apply_put_in_and_a_refused_apply_changes_nothing() {
         target: Some(Target::Coef { coef_ppm: 200_000 }),
         freq_chz: Some(4_100_000),
     };
-    apply(&mut station, &record).expect("applies");
+    apply(&mut station, &record, None).expect("applies");
     assert_eq!(capture(&station, "reference", 0), record);
     assert_eq!(station.drive_freq_chz(), 4_100_000);
 
@@ -306,12 +306,12 @@ fn capture_returns_what_apply_put_in_and_a_refused_apply_changes_nothing() {
         span_q16: 1,
     });
     bad.freq_chz = Some(7_000_000);
-    assert!(apply(&mut station, &bad).is_err());
+    assert!(apply(&mut station, &bad, None).is_err());
     assert_eq!(capture(&station, "reference", 0), record);
 
     // The defaults leave a fresh station as it is.
     let mut other = station_of(scene);
-    apply(&mut other, &Record::DEFAULTS).expect("applies");
+    apply(&mut other, &Record::DEFAULTS, None).expect("applies");
     assert_eq!(capture(&other, "reference", 0), fresh);
 }
 
@@ -340,4 +340,164 @@ fn station_of(scene: &crate::scene::Scene<'_>) -> crate::station::Station {
         channel(&scene.tangential_cell),
     )
     .expect("builds")
+}
+
+/// A commissioning as the sequence leaves it (Q = pi f0 tau), both cells tared.
+fn commissioned_sample() -> crate::commission::CommissionResult {
+    use crate::commission::{CellZero, CommissionResult, Measured};
+    let m = |value, standard_error| Measured {
+        value,
+        standard_error,
+    };
+    let (f0, tau) = (39_987.654_321, 0.000_817_3);
+    CommissionResult {
+        resonance_hz: m(f0, 0.52),
+        time_constant_s: m(tau, 4.95e-6),
+        quality_factor: m(core::f64::consts::PI * f0 * tau, 0.62),
+        natural_coefficient: m(0.263_1, 0.000_119),
+        ring_down_points: 25,
+        normal: CellZero {
+            zero_n: 0.0167,
+            noise_rms_n: Some(0.031),
+        },
+        tangential: CellZero {
+            zero_n: -0.0034,
+            noise_rms_n: Some(0.017),
+        },
+    }
+}
+
+/// `save` then a reset then `load`: the commissioned values come back bit for bit with the
+/// settings they were saved with, and are not used with other settings (a later save of
+/// declared values, or a power cut between the two writes).
+#[test]
+fn commissioned_values_survive_a_reset_with_their_settings_only() {
+    let result = commissioned_sample();
+    let mut s = store(new_flash());
+    assert_eq!(run(s.load_commissioned(&sample(1))), Ok(None));
+    run(s.save(&sample(1))).unwrap();
+    run(s.save_commissioned(&result, &sample(1))).unwrap();
+    let mut s = store(s.into_flash());
+    let booted = run(boot(&mut s, false, known));
+    assert_eq!(booted.record, sample(1));
+    assert_eq!(booted.commissioned, Ok(Some(result)));
+    // Without noise measured the noise fields read back as none.
+    let mut untared = result;
+    untared.tangential.noise_rms_n = None;
+    run(s.save_commissioned(&untared, &sample(1))).unwrap();
+    assert_eq!(run(s.load_commissioned(&sample(1))), Ok(Some(untared)));
+    // New settings saved without commissioning: the old commissioning is not theirs.
+    run(s.save(&sample(2))).unwrap();
+    let mut s = store(s.into_flash());
+    let booted = run(boot(&mut s, false, known));
+    assert_eq!((booted.record, booted.commissioned), (sample(2), Ok(None)));
+    // Defaults (nothing valid stored): no commissioning looked at.
+    run(s.store(1, &[0u8; 3])).unwrap();
+    let booted = run(boot(&mut s, false, known));
+    assert_eq!(booted.source, Source::Defaults(Invalid::Length));
+    assert_eq!(booted.commissioned, Ok(None));
+}
+
+/// A damaged commissioning is refused with the reason, never read as values; one with a
+/// valid CRC but a value outside its range is refused naming the check.
+#[test]
+fn a_corrupted_commissioning_is_refused_with_its_reason() {
+    let record = sample(1);
+    let good = encode_commissioned(&commissioned_sample(), &record);
+    let recrc = |mut bytes: [u8; COMMISSIONED_LEN]| {
+        let crc = crc32(&bytes[..112]);
+        bytes[112..].copy_from_slice(&crc.to_le_bytes());
+        bytes
+    };
+    let decode = |bytes: &[u8]| decode_commissioned(bytes, &record);
+    assert_eq!(decode(&good), Ok(Some(commissioned_sample())));
+    assert_eq!(decode(&good[..115]), Err(CommissionedInvalid::Length));
+    assert_eq!(
+        decode(&[0xFF; COMMISSIONED_LEN]),
+        Err(CommissionedInvalid::Magic)
+    );
+    let mut bad = good;
+    bad[4] = 2;
+    assert_eq!(decode(&bad), Err(CommissionedInvalid::Version(2)));
+    for at in [5, 9, 12, 20, 70, 111, 113] {
+        let mut bad = good;
+        bad[at] ^= 0x20;
+        assert_eq!(decode(&bad), Err(CommissionedInvalid::Crc), "byte {at}");
+    }
+    let mut bad = good;
+    bad[5] |= 0x40;
+    assert_eq!(decode(&recrc(bad)), Err(CommissionedInvalid::Flags));
+    // A noise behind a cleared flag.
+    let mut bad = good;
+    bad[5] &= !1;
+    assert_eq!(decode(&recrc(bad)), Err(CommissionedInvalid::Flags));
+    // mu0 of 2.5 with a valid CRC: the range check.
+    let mut bad = good;
+    bad[64..72].copy_from_slice(&2.5f64.to_le_bytes());
+    assert_eq!(
+        decode(&recrc(bad)),
+        Err(CommissionedInvalid::Range {
+            step: crate::commission::Step::Natural,
+            reason: "mu0 outside (0, 2]",
+        })
+    );
+    assert_eq!(
+        CommissionedInvalid::Range {
+            step: crate::commission::Step::Natural,
+            reason: "",
+        }
+        .reason(),
+        "commissioning-out-of-range"
+    );
+    // Through the store and the boot: the settings are used, the commissioning is not, and
+    // the boot says why.
+    let mut s = store(new_flash());
+    run(s.save(&record)).unwrap();
+    let mut damaged = good;
+    damaged[30] ^= 1;
+    run(s.store(3, &damaged)).unwrap();
+    let booted = run(boot(&mut s, false, known));
+    assert_eq!(booted.source, Source::Stored);
+    assert_eq!(booted.commissioned, Err(CommissionedInvalid::Crc));
+    assert_eq!(
+        booted.commissioned.unwrap_err().reason(),
+        "commissioning-crc-mismatch"
+    );
+}
+
+/// What `load` puts into a fresh station: the loop runs on the commissioned values, as the
+/// console's `commission` left it (`commissioned_settings`), the noise included (which a
+/// fresh station has not measured: the declared noise until then); `capture` and
+/// `Station::commissioned` give them back for the next `save`.
+#[test]
+fn applied_commissioned_values_are_what_the_loop_runs_on() {
+    let scene = crate::scene::builtin::find("reference").expect("built in");
+    let mut station = station_of(scene);
+    let declared = *station.settings();
+    let result = commissioned_sample();
+    let record = capture(&station, "reference", 0);
+    apply(&mut station, &record, Some(&result)).expect("applies");
+    let s = *station.settings();
+    assert_eq!(station.commissioned(), Some(result));
+    assert_eq!(
+        s,
+        crate::station::commissioned_settings(&declared, &result).expect("tuned")
+    );
+    assert_eq!(s.envelope_time_constant_s, result.time_constant_s.value);
+    assert_eq!(s.natural_prior, result.natural_coefficient.value);
+    assert_eq!(s.actuator.drive_frequency_hz, result.resonance_hz.value);
+    assert_eq!(s.normal_noise_n, 0.031);
+    assert_eq!(s.tangential_noise_n, 0.017);
+    assert_eq!(station.drive_freq_chz(), 3_998_765);
+    assert_eq!(
+        station.commission_report(),
+        crate::station::CommissionReport::Restored(result)
+    );
+    // Refused whole: a result out of range leaves the station as it was.
+    let mut fresh = station_of(scene);
+    let mut bad = result;
+    bad.natural_coefficient.value = 0.0;
+    assert!(apply(&mut fresh, &record, Some(&bad)).is_err());
+    assert_eq!(fresh.commissioned(), None);
+    assert_eq!(*fresh.settings(), declared);
 }

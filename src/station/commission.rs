@@ -5,18 +5,35 @@
 
 use super::Station;
 use crate::commission::{
-    CellZero, CommissionResult, Commissioning, PeriodInputs, Phase, Refusal, Step,
+    CellZero, CommissionResult, Commissioning, PeriodInputs, Phase, Refusal, Step, check,
 };
-use crate::control::{Config, Output};
+use crate::control::{Config, Output, Settings, tuned};
 use crate::drive::{Amplitude, Frequency};
 use crate::fx::{Q1_31, Q16_16};
 use crate::protocol::{Command, ProtocolError, SupervisorState};
-use crate::sense::Calibration;
+use crate::sense::{Calibration, SensorChannel};
+
+/// The station's commissioning: the last `commission` command, and the values the loop runs on
+/// (from that command, or restored from the settings store), which outlive a later refused
+/// `commission`.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct CommissionState {
+    last: LastCommission,
+    applied: Option<CommissionResult>,
+}
+
+impl CommissionState {
+    /// No `commission` given, the declared values.
+    pub(super) const NEVER: Self = Self {
+        last: LastCommission::Never,
+        applied: None,
+    };
+}
 
 /// The state of the last `commission`.
 #[derive(Debug, Clone, PartialEq)]
 #[allow(clippy::large_enum_variant)] // one per station, never moved in the control step
-pub(super) enum CommissionState {
+enum LastCommission {
     /// None was given since the station was built.
     Never,
     /// Running.
@@ -34,17 +51,40 @@ pub enum CommissionReport {
     Running(Step),
     /// Accepted and applied.
     Done(CommissionResult),
-    /// Refused.
+    /// Refused (the loop keeps the values it ran on before).
     Refused(Refusal),
+    /// No `commission` since the station was built, but the loop runs on values a former one
+    /// measured, restored from the settings store ([`Station::apply_commissioned`]).
+    Restored(CommissionResult),
+}
+
+/// Samples a cell's `tare` averages ([`super::COMMISSIONING_SAMPLES`]), for the standard errors
+/// of its zero and noise.
+const TARE_SAMPLES: f64 = super::COMMISSIONING_SAMPLES as f64;
+
+/// The standard error of a cell's zero, N: the mean of the tare's samples scatters by the
+/// noise over the square root of their count (`None` without a measured noise).
+pub fn zero_standard_error_n(cell: &CellZero) -> Option<f64> {
+    cell.noise_rms_n
+        .map(|noise| noise / libm::sqrt(TARE_SAMPLES))
+}
+
+/// The standard error of a cell's measured noise, N: an RMS over `n` Gaussian samples
+/// scatters by `sigma / sqrt(2 n)` (the chi distribution's spread for large `n`).
+pub fn noise_standard_error_n(cell: &CellZero) -> Option<f64> {
+    cell.noise_rms_n
+        .map(|noise| noise / libm::sqrt(2.0 * TARE_SAMPLES))
 }
 
 /// A cell's zero in newtons relative to mid-scale (the front ends' zero-force reading,
-/// [`crate::sense`]): what the unloaded cell reads through the datasheet calibration.
-fn cell_zero(calibration: Calibration) -> CellZero {
+/// [`crate::sense`]): what the unloaded cell reads through the datasheet calibration; with the
+/// noise its last `tare` measured, if it was tared.
+fn cell_zero(channel: &SensorChannel) -> CellZero {
+    let calibration: Calibration = channel.calibration();
     let offset = calibration.offset().to_f64() - 0.5;
     CellZero {
         zero_n: offset * calibration.span().to_f64(),
-        noise_rms_n: None,
+        noise_rms_n: channel.noise().map(Q16_16::to_f64),
     }
 }
 
@@ -53,7 +93,7 @@ impl Station {
     /// on a stack the resonance loop can model; accepted, the search starts.
     pub(super) fn start_commission(&mut self, command: &Command) -> Result<(), ProtocolError> {
         self.require_drive_off(command)?;
-        if matches!(self.commission, CommissionState::Running(_)) {
+        if self.commissioning() {
             return Err(ProtocolError::WrongState {
                 command: command.keyword(),
                 state: SupervisorState::Tuning,
@@ -77,35 +117,34 @@ impl Station {
         // stack well above the sense's noise and within its current rating.
         let ceiling = self.controller.config().limit().max_amplitude;
         let burst = Q1_31::from_bits(ceiling.to_bits() / 2);
-        let (normal, tangential) = self.calibrations();
         self.auto_armed = false;
-        self.commission = CommissionState::Running(Commissioning::new(
+        self.commission.last = LastCommission::Running(Commissioning::new(
             self.settings.period_s,
             burst,
-            cell_zero(normal),
-            cell_zero(tangential),
+            cell_zero(&self.normal),
+            cell_zero(&self.tangential),
         ));
         Ok(())
     }
 
     /// Whether commissioning is running (the station reports `tuning`).
     pub(super) fn commissioning(&self) -> bool {
-        matches!(self.commission, CommissionState::Running(_))
+        matches!(self.commission.last, LastCommission::Running(_))
     }
 
     /// `stop` during commissioning: it ends, refused, drive off, the resonance loop pinned.
     pub(super) fn cancel_commission(&mut self) {
-        if let CommissionState::Running(sequence) = &self.commission {
+        if let LastCommission::Running(sequence) = &self.commission.last {
             let step = sequence.step();
-            self.commission =
-                CommissionState::Finished(Err(Refusal::new(step, "stopped", f64::NAN)));
+            self.commission.last =
+                LastCommission::Finished(Err(Refusal::new(step, "stopped", f64::NAN)));
             self.pin_here();
         }
     }
 
     /// The period's current samples to the sequence.
     pub(super) fn commission_current(&mut self, codes: &[u16]) {
-        if let CommissionState::Running(sequence) = &mut self.commission {
+        if let LastCommission::Running(sequence) = &mut self.commission.last {
             sequence.push_current(codes);
         }
     }
@@ -120,7 +159,7 @@ impl Station {
         tangential_force: Q16_16,
         sliding_velocity_m_per_s: f32,
     ) {
-        let CommissionState::Running(sequence) = &mut self.commission else {
+        let LastCommission::Running(sequence) = &mut self.commission.last else {
             return;
         };
         let Some(resonance) = self.resonance.as_mut() else {
@@ -149,7 +188,7 @@ impl Station {
                 if result.is_err() {
                     self.pin_here();
                 }
-                self.commission = CommissionState::Finished(result);
+                self.commission.last = LastCommission::Finished(result);
                 Q1_31::ZERO
             }
         };
@@ -160,19 +199,19 @@ impl Station {
         self.applied = Amplitude::from_command(output.amplitude);
     }
 
-    /// The loop on the measured values: the controller's envelope time constant (and the lead,
-    /// which cannot make it slower) and its current ceiling at the measured f0, the drive pinned
-    /// at f0. All or nothing.
+    /// The loop on the measured values, all or nothing ([`commissioned_settings`]): the
+    /// controller's envelope time constant, its gains by the tuning rule with the measured
+    /// noise and mu0, mu0 as the prior of the learned natural coefficient (the estimate starts
+    /// there), the current ceiling at f0, the drive pinned at f0; the scene's nominal f0 and Q
+    /// (the detuning without a current sense) become the measured ones.
     fn apply_commission(&mut self, result: &CommissionResult) -> Result<(), Refusal> {
         let refused = |reason| Refusal::new(Step::Natural, reason, f64::NAN);
-        let mut settings = self.settings;
-        let tau = result.time_constant_s.value;
-        let f0 = result.resonance_hz.value;
-        settings.envelope_time_constant_s = tau;
-        settings.response_time_constant_s = libm::fmin(settings.response_time_constant_s, tau);
-        settings.actuator.drive_frequency_hz = f0;
+        check(result)?;
+        let settings = commissioned_settings(&self.settings, result)
+            .map_err(|_| refused("controller refused the values"))?;
         let config =
             Config::new(&settings).map_err(|_| refused("controller refused the values"))?;
+        let f0 = result.resonance_hz.value;
         let millihertz = libm::round(f0 * 1e3) as u32;
         let mut resonance = self.resonance.clone();
         if let Some(resonance) = resonance.as_mut() {
@@ -186,17 +225,76 @@ impl Station {
         let chz = millihertz / 10 + u32::from(millihertz % 10 >= 5);
         self.drive_freq_chz = chz;
         self.drive_hz = millihertz as f32 / 1000.0;
+        self.nominal_resonance_hz = f0;
+        self.quality_factor = result.quality_factor.value;
+        self.commission.applied = Some(*result);
         Ok(())
+    }
+
+    /// Puts commissioned values restored from the settings store into the loop
+    /// ([`crate::settings::apply`]): as a `commission` that ends with `result` does, all or
+    /// nothing. Refused while the drive runs or commissioning does, and for a result outside
+    /// its physical ranges ([`check`]).
+    pub fn apply_commissioned(&mut self, result: &CommissionResult) -> Result<(), Refusal> {
+        let drive_off = matches!(
+            self.controller.state(),
+            SupervisorState::Idle | SupervisorState::Fault | SupervisorState::Boot
+        );
+        if self.commissioning() || !drive_off {
+            return Err(Refusal::new(
+                Step::Resonance,
+                "the drive is on or commissioning runs",
+                f64::NAN,
+            ));
+        }
+        self.apply_commission(result)
+    }
+
+    /// The commissioned values the loop runs on, `None` while it runs on the scene's declared
+    /// ones (what `save` keeps, and `status` reports as `values=`).
+    pub fn commissioned(&self) -> Option<CommissionResult> {
+        self.commission.applied
     }
 
     /// The last `commission`: running (its step), done (the values the loop now runs on) or
     /// refused (why).
     pub fn commission_report(&self) -> CommissionReport {
-        match &self.commission {
-            CommissionState::Never => CommissionReport::Never,
-            CommissionState::Running(sequence) => CommissionReport::Running(sequence.step()),
-            CommissionState::Finished(Ok(result)) => CommissionReport::Done(*result),
-            CommissionState::Finished(Err(refusal)) => CommissionReport::Refused(*refusal),
+        match (&self.commission.last, self.commission.applied) {
+            (LastCommission::Never, None) => CommissionReport::Never,
+            (LastCommission::Never, Some(result)) => CommissionReport::Restored(result),
+            (LastCommission::Running(sequence), _) => CommissionReport::Running(sequence.step()),
+            (LastCommission::Finished(Ok(result)), _) => CommissionReport::Done(*result),
+            (LastCommission::Finished(Err(refusal)), _) => CommissionReport::Refused(*refusal),
         }
     }
+}
+
+/// `settings` on the commissioned values: the envelope time constant tau (and the lead, which
+/// cannot make it slower: `min(reference lead, tau)`, the rule of
+/// [`crate::control::controller_settings`]), the drive frequency f0 (the current ceiling),
+/// mu0 as the prior of the natural coefficient, the contact's relaxation lag scaled with it
+/// (the slip length `mu W / k_t` is proportional to mu: [`crate::control::contact_lag_s`]),
+/// each cell's measured noise where the tare measured it, then the tuning rule
+/// ([`tuned`]) for the gains on all of them. Errors: the rule refused a value.
+pub fn commissioned_settings(
+    settings: &Settings,
+    result: &CommissionResult,
+) -> Result<Settings, crate::control::ConfigError> {
+    let mut s = *settings;
+    let tau = result.time_constant_s.value;
+    let mu0 = result.natural_coefficient.value;
+    s.envelope_time_constant_s = tau;
+    s.response_time_constant_s = libm::fmin(Settings::REFERENCE.response_time_constant_s, tau);
+    s.actuator.drive_frequency_hz = result.resonance_hz.value;
+    if s.natural_prior > 0.0 {
+        s.contact_lag_s *= mu0 / s.natural_prior;
+    }
+    s.natural_prior = mu0;
+    if let Some(noise) = result.normal.noise_rms_n {
+        s.normal_noise_n = noise;
+    }
+    if let Some(noise) = result.tangential.noise_rms_n {
+        s.tangential_noise_n = noise;
+    }
+    tuned(&s)
 }

@@ -412,7 +412,8 @@ impl ControlLoop for BoardRig {
                 cycles,
             )
             .with_resonance(setup.station.resonance())
-            .with_reach(setup.station.run_reach()),
+            .with_reach(setup.station.run_reach())
+            .with_commissioned(setup.station.commissioned().is_some()),
         )
     }
 

@@ -90,12 +90,21 @@ impl Persistent for BoardRig {
         sonolube::settings::capture(self.station(), self.scene().name, 0)
     }
 
+    fn commissioned(&self) -> Option<sonolube::commission::CommissionResult> {
+        self.station().commissioned()
+    }
+
     /// The record's scene (the default scene when it has none) is selected afresh, which
     /// restores the scene's own calibration, drive frequency and no target; then the record's
-    /// calibrations go into the cells, its frequency to the station and TIM1, its target to
-    /// the controller. The record's values passed their range checks, so the last two are
+    /// calibrations go into the cells, its frequency to the station and TIM1, the
+    /// commissioned values to the station (f0 to TIM1 first, to its cHz), its target to the
+    /// controller. The record's values passed their range checks, so the last ones are
     /// not refused (a refusal is returned, with the scene already switched).
-    fn apply(&mut self, record: &Record) -> Result<(), ProtocolError> {
+    fn apply(
+        &mut self,
+        record: &Record,
+        commissioned: Option<&sonolube::commission::CommissionResult>,
+    ) -> Result<(), ProtocolError> {
         let name = match record.scene {
             Some(name) => name,
             None => SceneName::new(crate::DEFAULT_SCENE).ok_or(ProtocolError::SettingsInvalid {
@@ -114,6 +123,16 @@ impl Persistent for BoardRig {
         }
         if let Some(freq_chz) = record.freq_chz {
             self.execute(&Command::Freq { freq_chz })?;
+        }
+        if let Some(result) = commissioned {
+            // f0 is in 20-60 kHz (checked when read): rounding by adding a half.
+            let freq_chz = (result.resonance_hz.value * 100.0 + 0.5) as u32;
+            self.execute(&Command::Freq { freq_chz })?;
+            self.station_mut().apply_commissioned(result).map_err(|_| {
+                ProtocolError::SettingsInvalid {
+                    reason: "commissioning-refused-by-controller",
+                }
+            })?;
         }
         if let Some(target) = record.target {
             self.execute(&Command::Target(target))?;

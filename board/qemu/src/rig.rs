@@ -210,9 +210,18 @@ impl Persistent for SimulatedRig {
         sonolube::settings::capture(self.run.station(), self.scene.name, 0)
     }
 
+    fn commissioned(&self) -> Option<sonolube::commission::CommissionResult> {
+        self.run.station().commissioned()
+    }
+
     /// A new loop for the record's scene (the run's own scene when it has none) with the
-    /// record's calibrations, drive frequency and target; swapped in only when all applied.
-    fn apply(&mut self, record: &Record) -> Result<(), ProtocolError> {
+    /// record's calibrations, drive frequency and target, and the commissioned values saved
+    /// with it; swapped in only when all applied.
+    fn apply(
+        &mut self,
+        record: &Record,
+        commissioned: Option<&sonolube::commission::CommissionResult>,
+    ) -> Result<(), ProtocolError> {
         if self.run.mode() != Mode::Operated {
             return Err(ProtocolError::WrongState {
                 command: "load",
@@ -227,7 +236,9 @@ impl Persistent for SimulatedRig {
         if self.pristine && core::ptr::eq(scene, self.scene) {
             // The boot's case: the loop was just built for this scene. Building another would
             // need a second loop on the stack next to this one.
-            time_driver::exclude(|| sonolube::settings::apply(self.run.station_mut(), record))?;
+            time_driver::exclude(|| {
+                sonolube::settings::apply(self.run.station_mut(), record, commissioned)
+            })?;
             self.pristine = false;
             return Ok(());
         }
@@ -243,7 +254,9 @@ impl Persistent for SimulatedRig {
                 reason: "scene-cannot-run",
             }
         })?;
-        time_driver::exclude(|| sonolube::settings::apply(run.station_mut(), record))?;
+        time_driver::exclude(|| {
+            sonolube::settings::apply(run.station_mut(), record, commissioned)
+        })?;
         let changed = !core::ptr::eq(scene, self.scene);
         self.scene = scene;
         *self.run = run;
@@ -297,7 +310,8 @@ impl ControlLoop for SimulatedRig {
                 u32::try_from(cycles).unwrap_or(u32::MAX),
             )
             .with_resonance(self.run.station().resonance())
-            .with_reach(self.run.station().run_reach()),
+            .with_reach(self.run.station().run_reach())
+            .with_commissioned(self.run.station().commissioned().is_some()),
         )
     }
 

@@ -44,6 +44,8 @@ pub struct Status {
     pub reachable: Option<Target>,
     /// `near`, `far` or `unknown`: the drive frequency against the resonance.
     pub resonance: String,
+    /// `commissioned` or `declared`: the values the loop runs on (protocol 3).
+    pub values: String,
     /// Keys the reply carried that this protocol version does not document.
     pub extra_keys: Vec<String>,
 }
@@ -60,7 +62,7 @@ pub struct Version {
 }
 
 /// The keys of a `status` reply, in order.
-pub const STATUS_KEYS: [&str; 16] = [
+pub const STATUS_KEYS: [&str; 17] = [
     "state",
     "scene",
     "target",
@@ -77,6 +79,7 @@ pub const STATUS_KEYS: [&str; 16] = [
     "reach",
     "reachable",
     "resonance",
+    "values",
 ];
 
 /// The payload of an `ok` reply, or what the reply was instead.
@@ -139,6 +142,10 @@ pub fn decode_status(reply: &ReplyLine) -> Result<Status, String> {
             decode_target(text).map_err(|e| format!("reachable={text}: {e:?}"))?
         },
         resonance: field(&payload, "resonance")?.to_string(),
+        values: match field(&payload, "values")? {
+            word @ ("commissioned" | "declared") => word.to_string(),
+            other => return Err(format!("values={other} is not commissioned or declared")),
+        },
         extra_keys: payload
             .pairs()
             .map(|(key, _)| key)
@@ -202,7 +209,7 @@ mod tests {
             "ok state=running scene=demo target=coef:0.150000 mu=0.151000 normal_n=40.000 \
              tangential_n=-6.040 amp=0.523000 freq_hz=40000.00 overruns=0 lost=3 fault=none \
              lock=locked phase_deg=-0.250 reach=target-unreachable reachable=coef:0.180000 \
-             resonance=near",
+             resonance=near values=commissioned",
         ))
         .unwrap();
         assert_eq!(status.state, SupervisorState::Running);
@@ -219,6 +226,7 @@ mod tests {
         assert_eq!(status.reach, "target-unreachable");
         assert_eq!(status.reachable, Some(Target::Coef { coef_ppm: 180_000 }));
         assert_eq!(status.resonance, "near");
+        assert_eq!(status.values, "commissioned");
         assert!(status.extra_keys.is_empty());
         // The signed kind (issue 27), and a malformed one named.
         let line = "ok state=running scene=horn-motor target=net-force:-5.000 mu=0.151000 \
@@ -235,7 +243,8 @@ mod tests {
     fn missing_or_bad_fields_are_named() {
         let full = "ok state=idle scene=none target=none mu=0.240000 normal_n=40.000 \
                     tangential_n=9.600 amp=0.000000 freq_hz=40000.00 overruns=0 lost=0 fault=none \
-                    lock=pinned phase_deg=undefined reach=ok reachable=none resonance=unknown";
+                    lock=pinned phase_deg=undefined reach=ok reachable=none resonance=unknown \
+                    values=declared";
         assert!(decode_status(&reply(full)).is_ok());
         for key in STATUS_KEYS {
             let without: Vec<&str> = full
@@ -250,6 +259,9 @@ mod tests {
         assert!(error.starts_with("mu="), "{error}");
         let error = decode_status(&reply(&full.replace("idle", "asleep"))).unwrap_err();
         assert!(error.contains("asleep"), "{error}");
+        let error =
+            decode_status(&reply(&full.replace("values=declared", "values=guessed"))).unwrap_err();
+        assert!(error.starts_with("values=guessed"), "{error}");
         assert!(decode_status(&reply("err 1 unknown-command x")).is_err());
         assert!(decode_status(&reply("ok a")).is_err());
     }
