@@ -47,6 +47,7 @@
 
 use core::f32::consts::TAU;
 
+use sonolube::fx::Turns;
 use sonolube::scene;
 
 use super::noise::Gaussian;
@@ -90,8 +91,8 @@ pub struct ResonantTransducer {
     resistance_ohm: f32,
     /// Vibration amplitude, fraction of full scale, [0, 1].
     envelope: f32,
-    /// Drive phase at the current time, turns x 2^32.
-    phase: u32,
+    /// Drive phase at the current time (U0.32 turns).
+    phase: Turns,
     command: f32,
     drive_hz: f32,
     time_s: f32,
@@ -169,7 +170,7 @@ impl ResonantTransducer {
             capacitance_f: transducer.clamped_capacitance_f as f32,
             resistance_ohm: transducer.motional_resistance_ohm as f32,
             envelope: 0.0,
-            phase: 0,
+            phase: Turns::ZERO,
             command: 0.0,
             drive_hz: transducer.drive_hz as f32,
             time_s: 0.0,
@@ -287,7 +288,7 @@ impl ResonantTransducer {
         let whole = libm::floorf(turns) as u64;
         self.unwrapped = self
             .unwrapped
-            .wrapping_add((whole << 32) + u64::from(advance));
+            .wrapping_add((whole << 32) + u64::from(advance.bits()));
         if !self.bvd {
             return;
         }
@@ -383,7 +384,7 @@ impl ResonantTransducer {
 
     /// Drive phase now, rad in [0, 2 pi).
     pub fn phase_rad(&self) -> f32 {
-        self.phase as f32 * (TAU / 4_294_967_296.0)
+        self.phase.bits() as f32 * (TAU / 4_294_967_296.0)
     }
 
     /// Drive voltage waveform `V cos(theta)`, V, at `offset_s` after now (|offset| up to a few
@@ -412,16 +413,17 @@ impl ResonantTransducer {
         let turns = self
             .phase
             .wrapping_add(turn_fraction(self.drive_hz * offset_s));
-        turns as f32 * (TAU / 4_294_967_296.0)
+        turns.bits() as f32 * (TAU / 4_294_967_296.0)
     }
 }
 
-/// The fractional part of `turns` (any sign) as turns x 2^32.
-fn turn_fraction(turns: f32) -> u32 {
+/// The fractional part of `turns` (any sign) as a phase, truncated to 2^-32 turn (`f32`: the
+/// plant's own arithmetic, kept as it was; [`Turns::from_turns`] rounds in `f64`).
+fn turn_fraction(turns: f32) -> Turns {
     let fraction = turns - libm::floorf(turns);
     // fraction is in [0, 1]; a 1.0 from rounding saturates to u32::MAX, one count short of a
     // whole turn.
-    (fraction * 4_294_967_296.0) as u32
+    Turns::from_bits((fraction * 4_294_967_296.0) as u32)
 }
 
 #[cfg(test)]
