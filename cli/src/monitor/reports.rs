@@ -232,7 +232,7 @@ mod tests {
         let line = "ok state=running scene=horn-motor target=net-force:-5.000 mu=0.151000 \
                     normal_n=40.000 tangential_n=5.010 amp=0.523000 freq_hz=20000.00 overruns=0 \
                     lost=0 fault=none lock=pinned phase_deg=undefined reach=ok reachable=none \
-                    resonance=near";
+                    resonance=near values=declared";
         let status = decode_status(&reply(line)).unwrap();
         assert_eq!(status.target, Some(Target::NetForce { force_mn: -5_000 }));
         let error = decode_status(&reply(&line.replace("-5.000", "-5.0001"))).unwrap_err();
