@@ -13,6 +13,11 @@ const SUBCOMMANDS: &[Subcommand] = &[
         sonolube_cli::commands::dahl_table::run,
     ),
     (
+        "docs",
+        "regenerate or check the measured figures of the docs (generated blocks)",
+        sonolube_cli::commands::docs::run,
+    ),
+    (
         "eval",
         "evaluate a model in fixed point and f64 (JSON)",
         sonolube_cli::commands::eval::run,
