@@ -185,8 +185,6 @@ const GENERATED_DIR: &str = "docs/generated";
 const END: &str = "<!-- end generated -->";
 const BEGIN: &str = "<!-- generated: ";
 
-const USAGE: &str = "usage: sonolube docs --write [NAME...]\n       sonolube docs --render\n       sonolube docs --check [--logs DIR]\n       sonolube docs --list\n";
-
 /// The documents that may hold blocks, relative to the repository root, in a fixed order.
 pub fn documents(root: &Path) -> Vec<PathBuf> {
     let mut docs: Vec<PathBuf> = std::fs::read_dir(root.join("docs"))
@@ -526,62 +524,76 @@ fn render_all(root: &Path) -> Result<(), String> {
     Ok(())
 }
 
-fn usage(message: &str) -> ExitCode {
-    eprint!("sonolube docs: {message}\n{USAGE}");
-    ExitCode::from(2)
+/// The command line of `sonolube docs`.
+#[derive(clap::Parser, Debug)]
+#[command(
+    name = "docs",
+    bin_name = "sonolube docs",
+    about = "Regenerate or check the measured figures of README.md, scenes/README.md and docs/*.md (the generated blocks)",
+    group(clap::ArgGroup::new("mode").required(true).args(["write", "render", "check", "list"])),
+    after_help = "Exit status: 0 done (or current), 1 a stale block or a failed command, 2 usage."
+)]
+pub struct Args {
+    /// Measure the named blocks (every block when none), then rewrite every block.
+    #[arg(long, value_name = "NAME", num_args = 0..)]
+    pub write: Option<Vec<String>>,
+    /// Rewrite every block from the recorded outputs; measure nothing.
+    #[arg(long)]
+    pub render: bool,
+    /// Exit 1 unless every block is current (seconds: what scripts/test runs).
+    #[arg(long)]
+    pub check: bool,
+    /// With --check: scripts/test's log directory, whose QEMU logs the QEMU blocks' recordings must equal.
+    #[arg(long, value_name = "DIR", requires = "check")]
+    pub logs: Option<PathBuf>,
+    /// Every block, its command and what --check does with it.
+    #[arg(long)]
+    pub list: bool,
 }
 
 /// Entry point: `args` are the arguments after `docs`.
 pub fn run(args: &[String]) -> ExitCode {
     let root = repo_root();
-    let Some((mode, rest)) = args.split_first() else {
-        return usage("--write, --render, --check or --list is required");
+    let args = match super::args::parse::<Args>(args) {
+        Ok(args) => args,
+        Err(code) => return code,
     };
-    let result = match mode.as_str() {
-        "--write" => {
-            let mut chosen = Vec::new();
-            for name in rest {
-                match registered(name) {
-                    Ok(block) => chosen.push(block),
-                    Err(e) => return usage(&e),
-                }
+    let result = if let Some(names) = &args.write {
+        let mut chosen = Vec::new();
+        for name in names {
+            match registered(name) {
+                Ok(block) => chosen.push(block),
+                Err(e) => return super::args::usage_error::<Args>(&e),
             }
-            if chosen.is_empty() {
-                chosen = BLOCKS.iter().collect();
-            }
-            measure(&root, &chosen).and_then(|()| render_all(&root))
         }
-        "--render" if rest.is_empty() => render_all(&root),
-        "--list" if rest.is_empty() => {
-            let mut text = String::new();
-            for block in BLOCKS {
-                let cost = match block.cost {
-                    Cost::Seconds => "rerun by --check".to_string(),
-                    Cost::Slow { why, .. } => format!("recorded ({why})"),
-                };
-                let _ = writeln!(text, "{:<20} {cost}\n    {}", block.name, block.run);
-            }
-            print!("{text}");
-            Ok(())
+        if chosen.is_empty() {
+            chosen = BLOCKS.iter().collect();
         }
-        "--check" => {
-            let logs = match rest {
-                [] => None,
-                [flag, dir] if flag == "--logs" => Some(PathBuf::from(dir)),
-                _ => return usage("--check takes only --logs DIR"),
+        measure(&root, &chosen).and_then(|()| render_all(&root))
+    } else if args.render {
+        render_all(&root)
+    } else if args.list {
+        let mut text = String::new();
+        for block in BLOCKS {
+            let cost = match block.cost {
+                Cost::Seconds => "rerun by --check".to_string(),
+                Cost::Slow { why, .. } => format!("recorded ({why})"),
             };
-            let problems = check(&root, logs.as_deref(), &mut |line| println!("{line}"));
-            if problems.is_empty() {
-                println!("every generated block is current ({} blocks)", BLOCKS.len());
-                Ok(())
-            } else {
-                for problem in &problems {
-                    eprintln!("STALE {problem}");
-                }
-                Err(format!("{} stale generated block(s)", problems.len()))
-            }
+            let _ = writeln!(text, "{:<20} {cost}\n    {}", block.name, block.run);
         }
-        other => return usage(&format!("unknown arguments {other:?} {rest:?}")),
+        print!("{text}");
+        Ok(())
+    } else {
+        let problems = check(&root, args.logs.as_deref(), &mut |line| println!("{line}"));
+        if problems.is_empty() {
+            println!("every generated block is current ({} blocks)", BLOCKS.len());
+            Ok(())
+        } else {
+            for problem in &problems {
+                eprintln!("STALE {problem}");
+            }
+            Err(format!("{} stale generated block(s)", problems.len()))
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
