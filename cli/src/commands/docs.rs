@@ -154,6 +154,16 @@ pub const BLOCKS: &[Block] = &[
         },
     },
     Block {
+        name: "seeds-100",
+        run: "SONOLUBE_JOBS=2 sonolube scene --all --seeds 100",
+        show: None,
+        fence: true,
+        cost: Cost::Slow {
+            why: "1,300 closed-loop runs, about a minute on 2 cores",
+            fresh: &[],
+        },
+    },
+    Block {
         name: "size-g474",
         run: "cargo build --quiet --release --target thumbv7em-none-eabihf -p sonolube-nucleo-g474re && scripts/size-report --top 0 target/thumbv7em-none-eabihf/release/sonolube-nucleo-g474re",
         show: None,
