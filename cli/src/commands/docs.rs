@@ -389,7 +389,7 @@ fn first_difference(a: &str, b: &str) -> String {
             (Some(x), Some(y)) if x == y => continue,
             (x, y) => {
                 return format!(
-                    "first difference at line {number} of the block:\n      is: {}\n  should: {}",
+                    "first difference at line {number}:\n      is: {}\n  should: {}",
                     x.unwrap_or("(nothing)"),
                     y.unwrap_or("(nothing)")
                 );
