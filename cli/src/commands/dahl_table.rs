@@ -6,15 +6,25 @@ use std::process::ExitCode;
 use crate::speed::repo_root;
 use sonolube_host::dahl_table::{PATH, render};
 
+/// The command line of `sonolube dahl-table`.
+#[derive(clap::Parser, Debug)]
+#[command(
+    name = "dahl-table",
+    bin_name = "sonolube dahl-table",
+    about = "Write src/model/dahl/dahl_table_nodes.rs from the f64 reference (about 80 s), or check it",
+    after_help = "Exit status: 0 written (or current), 1 a failed reference or a stale file, 2 usage."
+)]
+pub struct Args {
+    /// Write nothing: exit 1 unless the committed nodes are what the reference gives.
+    #[arg(long)]
+    pub check: bool,
+}
+
 /// Entry point: `args` are the arguments after `dahl-table`.
 pub fn run(args: &[String]) -> ExitCode {
-    let check = match args {
-        [] => false,
-        [flag] if flag == "--check" => true,
-        _ => {
-            eprintln!("usage: sonolube dahl-table [--check]");
-            return ExitCode::from(2);
-        }
+    let check = match super::args::parse::<Args>(args) {
+        Ok(args) => args.check,
+        Err(code) => return code,
     };
     let text = match render() {
         Ok(text) => text,

@@ -44,37 +44,55 @@ pub const VARIANT_KEYS: &[&str] = &[
     "quadrature_points",
 ];
 
-const USAGE: &str =
-    "usage: sonolube eval MODEL key=value ... | sonolube eval --batch | sonolube eval --list\n";
+/// The command line of `sonolube eval`.
+#[derive(clap::Parser, Debug)]
+#[command(
+    name = "eval",
+    bin_name = "sonolube eval",
+    about = "Evaluate a model in fixed point and in the f64 reference, as JSON",
+    after_help = "A KEY that is a variant key (E_star_rule, contact, window, u_phase, \
+                  quadrature_points) chooses a variant; every other KEY is an input in SI units.\n\
+                  Exit status: 0, or 1 when the single evaluation failed; 2 usage."
+)]
+pub struct Args {
+    /// Print the model names.
+    #[arg(long)]
+    pub list: bool,
+    /// Read JSON lines {"model", "inputs", "variant"} on stdin, answer each on stdout.
+    #[arg(long, conflicts_with_all = ["list", "model"])]
+    pub batch: bool,
+    /// The model to evaluate (`--list` names them).
+    pub model: Option<String>,
+    /// Inputs and variant choices.
+    #[arg(value_name = "KEY=VALUE", allow_hyphen_values = true)]
+    pub words: Vec<String>,
+}
 
 /// Entry point of `sonolube eval`.
 pub fn run(args: &[String]) -> ExitCode {
-    match args.first().map(String::as_str) {
-        None | Some("--help") | Some("-h") => {
-            eprint!("{USAGE}");
-            ExitCode::from(2)
+    let args = match super::args::parse::<Args>(args) {
+        Ok(args) => args,
+        Err(code) => return code,
+    };
+    if args.list {
+        for model in models() {
+            println!("{model}");
         }
-        Some("--list") => {
-            for model in models() {
-                println!("{model}");
-            }
-            ExitCode::SUCCESS
-        }
-        Some("--batch") if args.len() == 1 => batch(),
-        Some("--batch") => {
-            eprint!("{USAGE}");
-            ExitCode::from(2)
-        }
-        Some(model) => {
-            let answer = single(model, &args[1..]);
-            let failed = answer.get("error").is_some();
-            println!("{answer}");
-            if failed {
-                ExitCode::from(1)
-            } else {
-                ExitCode::SUCCESS
-            }
-        }
+        return ExitCode::SUCCESS;
+    }
+    if args.batch {
+        return batch();
+    }
+    let Some(model) = args.model else {
+        return super::args::usage_error::<Args>("a MODEL, --batch or --list is needed");
+    };
+    let answer = single(&model, &args.words);
+    let failed = answer.get("error").is_some();
+    println!("{answer}");
+    if failed {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
     }
 }
 

@@ -27,46 +27,70 @@ use crate::monitor::{
     parse_step, run_acceptance, run_commission, run_steps, telemetry_csv, telemetry_svg,
 };
 
-const USAGE: &str = "\
-usage: sonolube monitor --connect ENDPOINT [-c CMD]... [--script FILE]... [--acceptance]
-                        [--csv FILE] [--svg FILE] [--allow-errors] [options]
-
-Sends each command to the firmware, waits for its reply and prints both ('> command',
-'< reply'); records the telemetry; optionally runs the acceptance test of the command
-interface after the commands.
-
-  --connect ENDPOINT       unix:PATH       Unix socket (QEMU -chardev socket), retried until
-                                           it accepts or --connect-timeout-ms passes
-                           tcp:HOST:PORT   TCP connection, retried the same way
-                           serial:DEV[@BAUD]  serial port, 8N1, default 115200 baud
-  -c, --command CMD        send CMD (repeatable; -c and --script run in the order given)
-  --script FILE            send FILE's lines: one command per line, blank lines and lines
-                           starting with '#' skipped, and 'wait MS': MS ms of firmware time
-                           (telemetry t_us) while telemetry is on, of wall time while it is off
-  --commission             after the commands: 'commission' (drive off, contact loaded and
-                           sliding), then 'commission status' every 20 ms until it ends; exit 1
-                           unless it is done (f0, Q, tau, mu0 with their standard errors)
-  --acceptance             run the acceptance test (6 checks, 'monitor acceptance: N passed,
-                           M failed'); exit 1 unless all pass
-  --csv FILE               write every telemetry record: header row, one column per field
-  --svg FILE               plot the telemetry: friction target and estimate, drive amplitude,
-                           forces
-  --allow-errors           exit 0 even when a command got an err reply
-  --timeout-ms MS          longest wait for a reply, and longest telemetry silence while
-                           waiting on it (default 5000)
-  --connect-timeout-ms MS  how long to retry connecting to a socket (default 10000)
-  --seed N                 seed of the acceptance flood (decimal or 0x hex; default 0x50a01be5)
-  --flood-lines N          malformed lines in the acceptance flood (default 10000)
-  --window N               flood lines sent ahead of their replies (default 4)
-  --telemetry-hz N         telemetry rate of the acceptance test (default 1000; lower it on a
-                           115200-baud serial port, the observation lengthens to match)
-
-The --csv and --svg paths are checked before connecting: if one cannot be written, nothing
-is sent.
-
-exit status: 0 all ok; 1 an err reply, a failed check, a lost or silent connection, malformed
-lines from the firmware, or an unwritable output file; 2 a usage error
-";
+/// The command line of `sonolube monitor`.
+#[derive(clap::Parser, Debug)]
+#[command(
+    name = "monitor",
+    bin_name = "sonolube monitor",
+    about = "Talk to the firmware: send commands and print their replies ('> command', '< reply'), \
+             record the telemetry, run the acceptance test of the command interface",
+    after_help = "The --csv and --svg paths are checked before connecting: if one cannot be \
+                  written, nothing is sent.\n\n\
+                  Exit status: 0 all ok; 1 an err reply, a failed check, a lost or silent \
+                  connection, malformed lines from the firmware, or an unwritable output file; \
+                  2 a usage error."
+)]
+pub struct Args {
+    /// unix:PATH (Unix socket, QEMU -chardev socket), tcp:HOST:PORT, or serial:DEV[@BAUD]
+    /// (8N1, default 115200 baud); sockets are retried until they accept or
+    /// --connect-timeout-ms passes.
+    #[arg(long, value_name = "ENDPOINT")]
+    pub connect: Option<String>,
+    /// Send CMD (repeatable; -c and --script run in the order given).
+    #[arg(short = 'c', long = "command", value_name = "CMD")]
+    pub commands: Vec<String>,
+    /// Send FILE's lines: one command per line, blank lines and lines starting with '#'
+    /// skipped, and 'wait MS': MS ms of firmware time (telemetry t_us) while telemetry is on,
+    /// of wall time while it is off.
+    #[arg(long, value_name = "FILE")]
+    pub script: Vec<String>,
+    /// After the commands: 'commission' (drive off, contact loaded and sliding), then
+    /// 'commission status' every 20 ms until it ends; exit 1 unless it is done.
+    #[arg(long)]
+    pub commission: bool,
+    /// Run the acceptance test after the commands ('monitor acceptance: N passed, M failed');
+    /// exit 1 unless all pass.
+    #[arg(long)]
+    pub acceptance: bool,
+    /// Write every telemetry record: header row, one column per field.
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
+    /// Plot the telemetry: friction target and estimate, drive amplitude, forces.
+    #[arg(long, value_name = "FILE")]
+    pub svg: Option<PathBuf>,
+    /// Exit 0 even when a command got an err reply.
+    #[arg(long)]
+    pub allow_errors: bool,
+    /// Longest wait for a reply, and longest telemetry silence while waiting on it (default 5000).
+    #[arg(long, value_name = "MS")]
+    pub timeout_ms: Option<String>,
+    /// How long to retry connecting to a socket (default 10000).
+    #[arg(long, value_name = "MS")]
+    pub connect_timeout_ms: Option<String>,
+    /// Seed of the acceptance flood (decimal or 0x hex; default 0x50a01be5).
+    #[arg(long, value_name = "N")]
+    pub seed: Option<String>,
+    /// Malformed lines in the acceptance flood (default 10000).
+    #[arg(long, value_name = "N")]
+    pub flood_lines: Option<String>,
+    /// Flood lines sent ahead of their replies (default 4).
+    #[arg(long, value_name = "N")]
+    pub window: Option<String>,
+    /// Telemetry rate of the acceptance test (default 1000; lower it on a 115200-baud serial
+    /// port, the observation lengthens to match).
+    #[arg(long, value_name = "N")]
+    pub telemetry_hz: Option<String>,
+}
 
 /// The parsed command line.
 struct Options {
@@ -87,19 +111,18 @@ pub fn run(args: &[String]) -> ExitCode {
     let options = match parse_args(args) {
         Ok(Some(options)) => options,
         Ok(None) => {
-            print!("{USAGE}");
+            print!(
+                "{}",
+                <Args as clap::CommandFactory>::command().render_long_help()
+            );
             return ExitCode::SUCCESS;
         }
-        Err(problem) => {
-            eprint!("sonolube monitor: {problem}\n\n{USAGE}");
-            return ExitCode::from(2);
-        }
+        Err(problem) => return super::args::usage_error::<Args>(&problem),
     };
     if options.steps.is_empty() && !options.acceptance && !options.commission {
-        eprint!(
-            "sonolube monitor: nothing to do: give -c, --script, --commission or --acceptance\n\n{USAGE}"
+        return super::args::usage_error::<Args>(
+            "nothing to do: give -c, --script, --commission or --acceptance",
         );
-        return ExitCode::from(2);
     }
     for path in [&options.csv, &options.svg].into_iter().flatten() {
         if let Err(why) = check_writable(path) {
@@ -295,83 +318,65 @@ fn seed(text: &str) -> Result<u64, String> {
 
 /// `Ok(None)` for `--help`.
 fn parse_args(args: &[String]) -> Result<Option<Options>, String> {
-    let mut endpoint = None;
-    let mut steps = Vec::new();
-    let mut acceptance = false;
-    let mut commission = false;
-    let mut csv = None;
-    let mut svg = None;
-    let mut allow_errors = false;
+    let Some((args, matches)) = super::args::parse_matches::<Args>(args)? else {
+        return Ok(None);
+    };
     let mut link = LinkOptions::default();
     let mut config = AcceptanceConfig::default();
-    let mut rest = args.iter();
-    while let Some(flag) = rest.next() {
-        let flag = flag.as_str();
-        match flag {
-            "-h" | "--help" => return Ok(None),
-            "--acceptance" => acceptance = true,
-            "--commission" => commission = true,
-            "--allow-errors" => allow_errors = true,
-            "--connect"
-            | "-c"
-            | "--command"
-            | "--script"
-            | "--csv"
-            | "--svg"
-            | "--timeout-ms"
-            | "--connect-timeout-ms"
-            | "--seed"
-            | "--flood-lines"
-            | "--window"
-            | "--telemetry-hz" => {
-                let value = rest
-                    .next()
-                    .ok_or_else(|| format!("{flag} needs a value"))?
-                    .as_str();
-                match flag {
-                    "--connect" => endpoint = Some(Endpoint::parse(value)?),
-                    "-c" | "--command" => match parse_step(value) {
-                        Ok(Some(step)) => steps.push(step),
-                        Ok(None) => return Err(format!("{flag} {value:?}: no command")),
-                        Err(why) => return Err(format!("{flag}: {why}")),
-                    },
-                    "--script" => {
-                        let text = std::fs::read_to_string(value)
-                            .map_err(|e| format!("--script {value}: {e}"))?;
-                        steps.extend(parse_script(&text).map_err(|e| format!("{value}: {e}"))?);
-                    }
-                    "--csv" => csv = Some(PathBuf::from(value)),
-                    "--svg" => svg = Some(PathBuf::from(value)),
-                    "--timeout-ms" => {
-                        link.reply_timeout =
-                            Duration::from_millis(number::<u64>(flag, value)?.max(1));
-                    }
-                    "--connect-timeout-ms" => {
-                        link.connect_timeout = Duration::from_millis(number(flag, value)?);
-                    }
-                    "--seed" => config.seed = seed(value)?,
-                    "--flood-lines" => config.flood_lines = number(flag, value)?,
-                    "--telemetry-hz" => {
-                        config.telemetry_hz = number::<u16>(flag, value)
-                            .ok()
-                            .filter(|hz| (1..=10_000).contains(hz))
-                            .ok_or_else(|| format!("{flag} {value}: not 1..=10000"))?;
-                    }
-                    _ => config.window = number::<usize>(flag, value)?.max(1),
-                }
+    // The -c commands and the --script files, in the order given.
+    let mut given: Vec<(usize, &str, &String)> = Vec::new();
+    for (id, values) in [("commands", &args.commands), ("script", &args.script)] {
+        let indices = matches.indices_of(id).into_iter().flatten();
+        given.extend(indices.zip(values).map(|(index, value)| (index, id, value)));
+    }
+    given.sort_by_key(|(index, _, _)| *index);
+    let mut steps = Vec::new();
+    for (_, id, value) in given {
+        if id == "commands" {
+            match parse_step(value) {
+                Ok(Some(step)) => steps.push(step),
+                Ok(None) => return Err(format!("-c {value:?}: no command")),
+                Err(why) => return Err(format!("-c: {why}")),
             }
-            other => return Err(format!("unexpected argument {other:?}")),
+        } else {
+            let text =
+                std::fs::read_to_string(value).map_err(|e| format!("--script {value}: {e}"))?;
+            steps.extend(parse_script(&text).map_err(|e| format!("{value}: {e}"))?);
         }
     }
-    let endpoint = endpoint.ok_or("--connect ENDPOINT is required")?;
+    if let Some(value) = &args.timeout_ms {
+        link.reply_timeout = Duration::from_millis(number::<u64>("--timeout-ms", value)?.max(1));
+    }
+    if let Some(value) = &args.connect_timeout_ms {
+        link.connect_timeout = Duration::from_millis(number("--connect-timeout-ms", value)?);
+    }
+    if let Some(value) = &args.seed {
+        config.seed = seed(value)?;
+    }
+    if let Some(value) = &args.flood_lines {
+        config.flood_lines = number("--flood-lines", value)?;
+    }
+    if let Some(value) = &args.telemetry_hz {
+        config.telemetry_hz = number::<u16>("--telemetry-hz", value)
+            .ok()
+            .filter(|hz| (1..=10_000).contains(hz))
+            .ok_or_else(|| format!("--telemetry-hz {value}: not 1..=10000"))?;
+    }
+    if let Some(value) = &args.window {
+        config.window = number::<usize>("--window", value)?.max(1);
+    }
+    let endpoint = match &args.connect {
+        Some(text) => Endpoint::parse(text)?,
+        None => return Err("--connect ENDPOINT is required".into()),
+    };
     Ok(Some(Options {
         endpoint,
         steps,
-        acceptance,
-        commission,
-        csv,
-        svg,
-        allow_errors,
+        acceptance: args.acceptance,
+        commission: args.commission,
+        csv: args.csv,
+        svg: args.svg,
+        allow_errors: args.allow_errors,
         link,
         config,
     }))
@@ -412,6 +417,38 @@ mod tests {
         assert!(options.acceptance && !options.allow_errors);
         assert_eq!((options.config.seed, options.config.window), (16, 1));
         assert_eq!(options.link.reply_timeout, Duration::from_millis(250));
+    }
+
+    #[test]
+    fn commands_and_scripts_run_in_the_order_given() {
+        let dir =
+            std::env::temp_dir().join(format!("sonolube-monitor-order-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let script = dir.join("s.txt");
+        std::fs::write(&script, "start\nwait 7\n").unwrap();
+        let script = script.to_str().unwrap();
+        let options = parse_args(&args(&[
+            "-c",
+            "status",
+            "--script",
+            script,
+            "--connect",
+            "unix:/x",
+            "-c",
+            "stop",
+        ]))
+        .unwrap()
+        .unwrap();
+        assert_eq!(
+            options.steps,
+            [
+                Step::Command("status".into()),
+                Step::Command("start".into()),
+                Step::Wait(7),
+                Step::Command("stop".into()),
+            ]
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -21,15 +21,25 @@ use sonolube_host::fixed_eval::eval_fixed_named;
 use sonolube_host::papers::{Agreement, Evaluation, PAPER_CASES, PaperCase, Quantity};
 use sonolube_host::reference::eval_named;
 
+/// The command line of `sonolube papers`.
+#[derive(clap::Parser, Debug)]
+#[command(
+    name = "papers",
+    bin_name = "sonolube papers",
+    about = "Paper numbers against the f64 reference and the fixed point, as a markdown table",
+    after_help = "Exit status: 0, or 1 with --check when a case is outside its tolerance; 2 usage."
+)]
+pub struct Args {
+    /// Exit 1 when the fixed point or the reference misses a paper number's tolerance.
+    #[arg(long)]
+    pub check: bool,
+}
+
 /// Entry point of `sonolube papers`.
 pub fn run(args: &[String]) -> ExitCode {
-    let check = match args {
-        [] => false,
-        [flag] if flag == "--check" => true,
-        _ => {
-            eprintln!("usage: sonolube papers [--check]");
-            return ExitCode::from(2);
-        }
+    let check = match super::args::parse::<Args>(args) {
+        Ok(args) => args.check,
+        Err(code) => return code,
     };
     let (table, problems) = table();
     print!("{table}");

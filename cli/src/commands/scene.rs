@@ -91,84 +91,133 @@ use sonolube_sim::{ClosedLoop, RunSummary};
 pub use csv::csv;
 pub use report::{model_line, model_name, short};
 
-const USAGE: &str = "usage: sonolube scene NAME [--out DIR] [--file PATH.toml] [--model VARIANT] [--commission] \
-                     [--csv all|none|every N]\n       \
-                     sonolube scene --all [--out DIR]\n       \
-                     sonolube scene NAME|--all --seeds N|A-B [--plot PATH.svg]\n       \
-                     sonolube scene NAME --mismatch|--envelope|--noise|--resonators [--seeds N|A-B] [--out DIR]\n       \
-                     sonolube scene NAME --mismatch --pinned [--seeds N|A-B]\n\
-                     exit status: 0 every criterion passes (every run of a sweep); 1 one fails, \
-                     or the scene cannot run (a file that cannot be read or is invalid, values \
-                     that cannot build a run); 2 a usage error\n";
+/// The command line of `sonolube scene`.
+#[derive(clap::Parser, Debug)]
+#[command(
+    name = "scene",
+    bin_name = "sonolube scene",
+    about = "Run a scene closed loop on the host: CSV, SVG, the model it runs and why, each criterion's verdict",
+    args_override_self = true,
+    after_help = "sonolube scene NAME [--out DIR] [--file PATH.toml] [--model VARIANT] [--commission] [--csv all|none|every N]\n\
+                  sonolube scene --all [--out DIR]\n\
+                  sonolube scene NAME|--all --seeds N|A-B [--plot PATH.svg]\n\
+                  sonolube scene NAME --mismatch|--envelope|--noise|--resonators [--seeds N|A-B] [--out DIR]\n\
+                  sonolube scene NAME --mismatch --pinned [--seeds N|A-B]\n\n\
+                  Exit status: 0 every criterion passes (every run of a sweep); 1 one fails, or \
+                  the scene cannot run (a file that cannot be read or is invalid, values that \
+                  cannot build a run); 2 a usage error."
+)]
+pub struct Args {
+    /// A built-in scene (scenes/*.toml, compiled in).
+    pub name: Option<String>,
+    /// Every built-in scene: one line each, its verdicts, then the model it ran.
+    #[arg(long)]
+    pub all: bool,
+    /// Where NAME.csv and NAME.svg go.
+    #[arg(long, value_name = "DIR", default_value = "target/scenes")]
+    pub out: PathBuf,
+    /// Run a scene file (its `name` must be NAME when both are given).
+    #[arg(long, value_name = "PATH.toml")]
+    pub file: Option<PathBuf>,
+    /// Force a fixed-point model variant (a name of docs/speed.md's table).
+    #[arg(long, value_name = "VARIANT")]
+    pub model: Option<String>,
+    /// Run as if the scene had `commission = true`: measure f0, Q, tau and mu0 first.
+    #[arg(long)]
+    pub commission: bool,
+    /// The CSV's rows: all, none (the SVG from about 20,000 kept steps) or every N (one step
+    /// in N, plus every change of the supervisor's state).
+    #[arg(long, value_name = "all|none|every N")]
+    pub csv: Option<String>,
+    /// Noise seeds of a sweep: N (seeds 1 to N) or A-B.
+    #[arg(long, value_name = "N|A-B")]
+    pub seeds: Option<String>,
+    /// A sweep's distributions as an SVG plot.
+    #[arg(long, value_name = "PATH.svg")]
+    pub plot: Option<PathBuf>,
+    /// Sweep the mismatch grid (plant mu, k_t, cell gain, f0), drive `freq auto`.
+    #[arg(long)]
+    pub mismatch: bool,
+    /// Sweep the operating envelope (load, speed, reduction) as scene files.
+    #[arg(long)]
+    pub envelope: bool,
+    /// Sweep the sensor noise level.
+    #[arg(long)]
+    pub noise: bool,
+    /// Sweep resonators (f0 x Q), drive `freq auto`.
+    #[arg(long)]
+    pub resonators: bool,
+    /// With --mismatch: hold the drive at the scene's frequency instead of `freq auto`.
+    #[arg(long)]
+    pub pinned: bool,
+}
+
+/// `--csv every N` is two words on the command line; clap reads the option's value as one.
+fn join_csv_every(args: &[String]) -> Vec<String> {
+    let mut joined = Vec::with_capacity(args.len());
+    let mut rest = args.iter().peekable();
+    while let Some(arg) = rest.next() {
+        joined.push(arg.clone());
+        if arg == "--csv" && rest.peek().is_some_and(|v| *v == "every") {
+            rest.next();
+            match rest.next() {
+                Some(n) => joined.push(format!("every {n}")),
+                None => joined.push("every".into()),
+            }
+        }
+    }
+    joined
+}
 
 /// Entry point: `args` are the arguments after `scene`.
 pub fn run(args: &[String]) -> ExitCode {
-    let mut name = None;
-    let mut out = PathBuf::from("target/scenes");
-    let mut file = None;
-    let mut forced = None;
-    let mut all = false;
-    let mut seeds = None;
-    let mut plot = None;
-    let mut sweep = None;
-    let mut pinned = false;
-    let mut commission = false;
-    let mut rows = Rows::All;
-    let mut rest = args.iter();
-    while let Some(arg) = rest.next() {
-        match arg.as_str() {
-            "--all" => all = true,
-            "--mismatch" | "--envelope" | "--noise" | "--resonators" => {
-                if sweep.is_some() {
-                    return usage("one of --mismatch, --envelope, --noise, --resonators at a time");
-                }
-                sweep = Some(match arg.as_str() {
-                    "--mismatch" => robust::Sweep::Mismatch(robust::GridDrive::FreqAuto),
-                    "--envelope" => robust::Sweep::Envelope,
-                    "--resonators" => robust::Sweep::Resonators,
-                    _ => robust::Sweep::Noise,
-                });
-            }
-            "--out" | "--file" | "--model" | "--seeds" | "--plot" => {
-                let Some(value) = rest.next() else {
-                    return usage(&format!("{arg} needs a value"));
-                };
-                match arg.as_str() {
-                    "--out" => out = PathBuf::from(value),
-                    "--file" => file = Some(PathBuf::from(value)),
-                    "--plot" => plot = Some(PathBuf::from(value)),
-                    "--model" => match sonolube::variant::find(value) {
-                        Some(v) if v.form == sonolube::variant::Form::Fixed => forced = Some(v),
-                        _ => return usage(&format!("no fixed-point model variant '{value}'")),
-                    },
-                    _ => match robust::parse_seeds(value) {
-                        Ok(list) => seeds = Some(list),
-                        Err(problem) => return usage(&problem),
-                    },
-                }
-            }
-            "--pinned" => pinned = true,
-            "--commission" => commission = true,
-            "--csv" => {
-                rows = match rest.next().map(String::as_str) {
-                    Some("all") => Rows::All,
-                    Some("none") => Rows::None,
-                    Some("every") => match rest.next().map(|n| n.parse::<u32>()) {
-                        Some(Ok(n)) if n >= 1 => Rows::Every(n),
-                        _ => return usage("--csv every needs a whole number N >= 1"),
-                    },
-                    _ => return usage("--csv takes all, none or every N"),
-                }
-            }
-            "-h" | "--help" => {
-                print!("{USAGE}");
-                return ExitCode::SUCCESS;
-            }
-            flag if flag.starts_with('-') => return usage(&format!("unknown option {flag}")),
-            _ if name.is_none() => name = Some(arg.clone()),
-            _ => return usage(&format!("unexpected argument {arg}")),
-        }
+    let args = match super::args::parse::<Args>(&join_csv_every(args)) {
+        Ok(args) => args,
+        Err(code) => return code,
+    };
+    let (name, out, file, all, commission) =
+        (args.name, args.out, args.file, args.all, args.commission);
+    let plot = args.plot;
+    let pinned = args.pinned;
+    let forced = match &args.model {
+        None => None,
+        Some(value) => match sonolube::variant::find(value) {
+            Some(v) if v.form == sonolube::variant::Form::Fixed => Some(v),
+            _ => return usage(&format!("no fixed-point model variant '{value}'")),
+        },
+    };
+    let seeds = match &args.seeds {
+        None => None,
+        Some(value) => match robust::parse_seeds(value) {
+            Ok(list) => Some(list),
+            Err(problem) => return usage(&problem),
+        },
+    };
+    let sweeps = [
+        (
+            args.mismatch,
+            robust::Sweep::Mismatch(robust::GridDrive::FreqAuto),
+        ),
+        (args.envelope, robust::Sweep::Envelope),
+        (args.noise, robust::Sweep::Noise),
+        (args.resonators, robust::Sweep::Resonators),
+    ];
+    let mut chosen = sweeps.into_iter().filter(|(on, _)| *on).map(|(_, s)| s);
+    let mut sweep = chosen.next();
+    if chosen.next().is_some() {
+        return usage("one of --mismatch, --envelope, --noise, --resonators at a time");
     }
+    let rows = match args.csv.as_deref() {
+        None | Some("all") => Rows::All,
+        Some("none") => Rows::None,
+        Some(every) if every.starts_with("every") => {
+            match every["every".len()..].trim().parse::<u32>() {
+                Ok(n) if n >= 1 => Rows::Every(n),
+                _ => return usage("--csv every needs a whole number N >= 1"),
+            }
+        }
+        Some(_) => return usage("--csv takes all, none or every N"),
+    };
     if pinned {
         match sweep {
             Some(robust::Sweep::Mismatch(_)) => {
@@ -302,8 +351,7 @@ fn commissioned_lines(scene: &Scene<'_>, r: &sonolube::commission::CommissionRes
 }
 
 fn usage(problem: &str) -> ExitCode {
-    eprint!("sonolube scene: {problem}\n{USAGE}");
-    ExitCode::from(2)
+    super::args::usage_error::<Args>(problem)
 }
 
 fn exit(passed: bool) -> ExitCode {

@@ -29,11 +29,8 @@ use std::process::ExitCode;
 
 use crate::speed::{self, MARKDOWN, QEMU_LOG, markdown, timing};
 
-const USAGE: &str = "usage: sonolube speed --qemu LOG [--keep-host-ratios] [--root DIR]\n       sonolube speed --check [--qemu LOG] [--root DIR]\n";
-
 fn usage(message: &str) -> ExitCode {
-    eprint!("sonolube speed: {message}\n{USAGE}");
-    ExitCode::from(2)
+    super::args::usage_error::<Args>(message)
 }
 
 fn read(path: &str) -> Result<String, String> {
@@ -48,26 +45,37 @@ fn read(path: &str) -> Result<String, String> {
     }
 }
 
+/// The command line of `sonolube speed`.
+#[derive(clap::Parser, Debug)]
+#[command(
+    name = "speed",
+    bin_name = "sonolube speed",
+    about = "Speed against accuracy of every model variant: docs/speed.md, docs/speed.svg, src/variant/table.rs",
+    after_help = "Exit status: 0 done (or current), 1 a failed measurement or a stale file, 2 usage."
+)]
+pub struct Args {
+    /// The decoded log of the QEMU benchmark build (`-` for stdin); with --check, default docs/speed-qemu.txt.
+    #[arg(long, value_name = "LOG")]
+    pub qemu: Option<String>,
+    /// The repository to write under (default: this one).
+    #[arg(long, value_name = "DIR")]
+    pub root: Option<PathBuf>,
+    /// Write nothing, time nothing: exit 1 when a committed file is not what the committed counts give.
+    #[arg(long)]
+    pub check: bool,
+    /// Keep the committed host ratios instead of timing the host (any build).
+    #[arg(long)]
+    pub keep_host_ratios: bool,
+}
+
 /// Entry point: `args` are the arguments after `speed`.
 pub fn run(args: &[String]) -> ExitCode {
-    let (mut log, mut root, mut check) = (None, speed::repo_root(), false);
-    let mut keep_ratios = false;
-    let mut rest = args.iter();
-    while let Some(arg) = rest.next() {
-        match arg.as_str() {
-            "--qemu" => match rest.next() {
-                Some(path) => log = Some(path.clone()),
-                None => return usage("--qemu needs a file"),
-            },
-            "--root" => match rest.next() {
-                Some(dir) => root = PathBuf::from(dir),
-                None => return usage("--root needs a directory"),
-            },
-            "--check" => check = true,
-            "--keep-host-ratios" => keep_ratios = true,
-            other => return usage(&format!("unknown argument {other:?}")),
-        }
-    }
+    let args = match super::args::parse::<Args>(args) {
+        Ok(args) => args,
+        Err(code) => return code,
+    };
+    let (log, check, keep_ratios) = (args.qemu, args.check, args.keep_host_ratios);
+    let root = args.root.unwrap_or_else(speed::repo_root);
     let result = if check {
         let log = log.unwrap_or_else(|| root.join(QEMU_LOG).to_string_lossy().into_owned());
         run_check(&log, &root)
