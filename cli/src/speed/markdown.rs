@@ -536,7 +536,7 @@ impl Report<'_> {
              a 33 x 25 table (`u16`) over sqrt(1 - target) and log2(kappa |v| / omega), then takes \
              Newton steps (until one is below 2^-16 in w, at most four) along the curve the amplitudes trace through the table at a fixed \
              operating point (`sonolube::model::dahl_table`): the ratio at the amplitude it \
-             returns is the target within 2e-6 (`cli/tests/dahl_table.rs`). The inverse is \
+             returns is the target within 1e-6 (`cli/tests/dahl_table.rs`). The inverse is \
              counted in QEMU as above over the in-plane scenes' grids, the target being the \
              ratio at each grid point:\n"
         );
