@@ -129,6 +129,7 @@ pub use ln::ln_scaled;
 pub use q::{Q, Q1_31, Q2_30, Q3_29, Q5_27, Q6_26, Q8_24, Q16_16};
 pub use scaled::Scaled;
 pub use sqrt::isqrt_u64;
+pub(crate) use sqrt::sqrt_q32_approx;
 pub use trig::{Turns, cos, sin, sin_cos};
 
 /// The 64-bit helpers the rest of the core shares (one definition each).

@@ -147,7 +147,7 @@ pub struct Variant {
     /// at scene start and interpolated bilinearly ([`crate::model::cube_table`]: 5, 9 or 17);
     /// for the Dahl steady state, of F_avg / (mu W) over (mu_i(zeta), ln kappa x_a) compiled
     /// into flash from the f64 reference and interpolated bicubically
-    /// ([`crate::model::dahl_table`]: 33 or 65, alpha = 1). Fixed point only; 0 for a variant
+    /// ([`crate::model::dahl_table`]: 49 nodes in w by 73 in log2 kappa x_a, alpha = 1). Fixed point only; 0 for a variant
     /// that evaluates its model directly.
     pub table: u8,
 }
@@ -198,8 +198,7 @@ pub const CATALOGUE: &[Variant] = variants! {
     "Dahl steady N=64 f32 micromath" => DahlSteady, F32Micromath, 64;
     "Dahl steady N=64 f32 libm" => DahlSteady, F32Libm, 64;
     "Dahl steady N=64 f64" => DahlSteady, F64, 64;
-    "Dahl steady T=33x33" => DahlSteady, Fixed, 64, T 33;
-    "Dahl steady T=65x65" => DahlSteady, Fixed, 64, T 65;
+    "Dahl steady T=49x73" => DahlSteady, Fixed, 64, T 49;
     "cube el N=4" => CubeElastic, Fixed, 4;
     "cube el N=4 f32 micromath" => CubeElastic, F32Micromath, 4;
     "cube el N=4 f32 libm" => CubeElastic, F32Libm, 4;
@@ -292,16 +291,10 @@ pub const CONTROL_STEPS: &[(&str, &str, Fidelity, u8)] = &[
         0,
     ),
     (
-        "control step Dahl steady T=33x33",
+        "control step Dahl steady T=49x73",
         "compliant",
         Fidelity::DahlSteady,
-        33,
-    ),
-    (
-        "control step Dahl steady T=65x65",
-        "compliant",
-        Fidelity::DahlSteady,
-        65,
+        49,
     ),
     (
         "control step cube el N=16",

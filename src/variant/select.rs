@@ -17,7 +17,7 @@
 //!    scene's load range meets the budget (and it is not dearer).
 //! 3. Among the candidates (fixed point, the required level or a reduced one in the same family,
 //!    every quadrature knob and table size: the Coulomb ratio, the Dahl steady state at N = 16
-//!    to 64 and its tables `T=33x33`, `T=65x65`) the errors are measured against the reference
+//!    to 64 and its tables `T=49x73`) the errors are measured against the reference
 //!    level's exact `f64` model, and the reason line names that reference; the cheapest in Cortex-M4 instructions that meets the budget
 //!    wins, costs within [`COST_RESOLUTION`] of it counting as ties, which go to the lower level
 //!    (fewer parts), then to the more accurate (the table sizes cost the same per evaluation). When none meets it, the most accurate variant of the

@@ -19,11 +19,11 @@ pub static MEASURED: Measurements = Measurements {
 static COSTS: &[Cost] = &[
     Cost {
         variant: "Littmann closed form",
-        instructions: 45.093,
+        instructions: 49.688,
     },
     Cost {
         variant: "Littmann closed form f32 micromath",
-        instructions: 33.853,
+        instructions: 33.891,
     },
     Cost {
         variant: "Littmann closed form f32 libm",
@@ -31,19 +31,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Littmann closed form f64",
-        instructions: 3356.017,
+        instructions: 3356.055,
     },
     Cost {
         variant: "Dahl update",
-        instructions: 39.897,
+        instructions: 39.829,
     },
     Cost {
         variant: "Dahl update f32 micromath",
-        instructions: 107.282,
+        instructions: 107.111,
     },
     Cost {
         variant: "Dahl update f32 libm",
-        instructions: 61.504,
+        instructions: 61.641,
     },
     Cost {
         variant: "Dahl update f64",
@@ -51,23 +51,23 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 315.196,
+        instructions: 296.323,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 68.872,
+        instructions: 68.627,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 259.166,
+        instructions: 259.411,
     },
     Cost {
         variant: "Coulomb ratio f64",
-        instructions: 2720.098,
+        instructions: 2720.147,
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11353.548,
+        instructions: 11353.333,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
@@ -75,7 +75,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 31845.807,
+        instructions: 31846.021,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
@@ -83,79 +83,75 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20281.396,
+        instructions: 20281.236,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
-        instructions: 11294.784,
+        instructions: 11294.516,
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 58658.71,
+        instructions: 58659.03,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 269833.6,
+        instructions: 269832.6,
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 37995.86,
+        instructions: 37995.914,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22176.129,
+        instructions: 22175.86,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 111925.86,
+        instructions: 111924.35,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 511147.9,
+        instructions: 511148.2,
     },
     Cost {
-        variant: "Dahl steady T=33x33",
-        instructions: 910.752,
-    },
-    Cost {
-        variant: "Dahl steady T=65x65",
-        instructions: 911.935,
+        variant: "Dahl steady T=49x73",
+        instructions: 322.419,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 591.969,
+        instructions: 591.515,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
-        instructions: 377.878,
+        instructions: 378.03,
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 262.878,
+        instructions: 263.03,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9423.787,
+        instructions: 9423.484,
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 829.848,
+        instructions: 829.696,
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 632.121,
+        instructions: 631.666,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
-        instructions: 393.484,
+        instructions: 393.333,
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15228.636,
+        instructions: 15228.939,
     },
     Cost {
         variant: "cube el N=16",
-        instructions: 1305.757,
+        instructions: 1305.606,
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
@@ -163,15 +159,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=16 f32 libm",
-        instructions: 657.424,
+        instructions: 657.575,
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26878.94,
+        instructions: 26879.393,
     },
     Cost {
         variant: "cube el N=32",
-        instructions: 2257.878,
+        instructions: 2258.03,
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
@@ -183,11 +179,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50123.938,
+        instructions: 50123.637,
     },
     Cost {
         variant: "cube el T=5x5",
-        instructions: 282.727,
+        instructions: 282.878,
     },
     Cost {
         variant: "cube el T=9x9",
@@ -199,11 +195,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 591.969,
+        instructions: 591.666,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 378.03,
+        instructions: 378.181,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
@@ -211,19 +207,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9414.242,
+        instructions: 9414.696,
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 830.151,
+        instructions: 830.0,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 631.969,
+        instructions: 632.121,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
-        instructions: 393.333,
+        instructions: 393.787,
     },
     Cost {
         variant: "cube ep N=8 f64",
@@ -231,7 +227,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1305.606,
+        instructions: 1306.06,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
@@ -239,11 +235,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 657.272,
+        instructions: 657.878,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26867.424,
+        instructions: 26867.879,
     },
     Cost {
         variant: "cube ep N=32",
@@ -255,15 +251,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
-        instructions: 1183.484,
+        instructions: 1183.787,
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50110.91,
+        instructions: 50110.605,
     },
     Cost {
         variant: "cube ep T=5x5",
-        instructions: 282.575,
+        instructions: 282.878,
     },
     Cost {
         variant: "cube ep T=9x9",
@@ -271,7 +267,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep T=17x17",
-        instructions: 282.575,
+        instructions: 282.878,
     },
 ];
 
@@ -322,16 +318,9 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "compliant",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=49x73",
         reference: Fidelity::DahlSteady,
-        max_error: 4.09e-6,
-        points: 24,
-    },
-    SceneError {
-        scene: "compliant",
-        variant: "Dahl steady T=65x65",
-        reference: Fidelity::DahlSteady,
-        max_error: 8.27e-7,
+        max_error: 1.28e-5,
         points: 24,
     },
     SceneError {
@@ -812,16 +801,9 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "reference",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=49x73",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000254,
-        points: 24,
-    },
-    SceneError {
-        scene: "reference",
-        variant: "Dahl steady T=65x65",
-        reference: Fidelity::DahlSteady,
-        max_error: 2.29e-5,
+        max_error: 2.86e-5,
         points: 24,
     },
     SceneError {
@@ -861,16 +843,9 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "resonance-drift",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=49x73",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000382,
-        points: 120,
-    },
-    SceneError {
-        scene: "resonance-drift",
-        variant: "Dahl steady T=65x65",
-        reference: Fidelity::DahlSteady,
-        max_error: 3.21e-5,
+        max_error: 3.05e-5,
         points: 120,
     },
     SceneError {
@@ -910,16 +885,9 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "resonance-search",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=49x73",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000184,
-        points: 24,
-    },
-    SceneError {
-        scene: "resonance-search",
-        variant: "Dahl steady T=65x65",
-        reference: Fidelity::DahlSteady,
-        max_error: 2.62e-5,
+        max_error: 2.45e-5,
         points: 24,
     },
     SceneError {
@@ -959,16 +927,9 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "seatbelt",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=49x73",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000854,
-        points: 360,
-    },
-    SceneError {
-        scene: "seatbelt",
-        variant: "Dahl steady T=65x65",
-        reference: Fidelity::DahlSteady,
-        max_error: 6.55e-5,
+        max_error: 5.39e-5,
         points: 360,
     },
     SceneError {
@@ -1008,16 +969,9 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "sensor-fault",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=49x73",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000254,
-        points: 24,
-    },
-    SceneError {
-        scene: "sensor-fault",
-        variant: "Dahl steady T=65x65",
-        reference: Fidelity::DahlSteady,
-        max_error: 2.29e-5,
+        max_error: 2.86e-5,
         points: 24,
     },
     SceneError {
@@ -1057,16 +1011,9 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "sensor-spike",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=49x73",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000254,
-        points: 24,
-    },
-    SceneError {
-        scene: "sensor-spike",
-        variant: "Dahl steady T=65x65",
-        reference: Fidelity::DahlSteady,
-        max_error: 2.29e-5,
+        max_error: 2.86e-5,
         points: 24,
     },
     SceneError {
@@ -1106,16 +1053,9 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "sensor-stuck",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=49x73",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000254,
-        points: 24,
-    },
-    SceneError {
-        scene: "sensor-stuck",
-        variant: "Dahl steady T=65x65",
-        reference: Fidelity::DahlSteady,
-        max_error: 2.29e-5,
+        max_error: 2.86e-5,
         points: 24,
     },
     SceneError {
@@ -1155,16 +1095,9 @@ static ERRORS: &[SceneError] = &[
     },
     SceneError {
         scene: "stack-rail",
-        variant: "Dahl steady T=33x33",
+        variant: "Dahl steady T=49x73",
         reference: Fidelity::DahlSteady,
-        max_error: 0.000124,
-        points: 120,
-    },
-    SceneError {
-        scene: "stack-rail",
-        variant: "Dahl steady T=65x65",
-        reference: Fidelity::DahlSteady,
-        max_error: 1.29e-5,
+        max_error: 1.41e-5,
         points: 120,
     },
 ];
@@ -1173,102 +1106,97 @@ static ERRORS: &[SceneError] = &[
 static STEPS: &[StepCost] = &[
     StepCost {
         variant: "Coulomb ratio",
-        mean: 3241.76,
-        longest: 3560,
+        mean: 3209.92,
+        longest: 3520,
     },
     StepCost {
         variant: "Dahl steady N=16",
-        mean: 210268.16,
+        mean: 210266.88,
         longest: 262160,
     },
     StepCost {
         variant: "Dahl steady N=32",
-        mean: 380327.38,
+        mean: 380328.3,
         longest: 473920,
     },
     StepCost {
         variant: "Dahl steady N=64",
-        mean: 715292.6,
-        longest: 891960,
+        mean: 715292.2,
+        longest: 891920,
     },
     StepCost {
-        variant: "Dahl steady T=33x33",
-        mean: 5515.84,
-        longest: 6400,
-    },
-    StepCost {
-        variant: "Dahl steady T=65x65",
-        mean: 5654.56,
-        longest: 6560,
+        variant: "Dahl steady T=49x73",
+        mean: 3862.4,
+        longest: 4480,
     },
     StepCost {
         variant: "cube el N=4",
-        mean: 4698.901,
+        mean: 4698.756,
         longest: 6280,
     },
     StepCost {
         variant: "cube el N=8",
-        mean: 5689.338,
+        mean: 5689.327,
         longest: 7760,
     },
     StepCost {
         variant: "cube el N=16",
-        mean: 7665.901,
+        mean: 7665.854,
         longest: 10800,
     },
     StepCost {
         variant: "cube el N=32",
-        mean: 11622.88,
+        mean: 11622.814,
         longest: 16840,
     },
     StepCost {
         variant: "cube el T=5x5",
-        mean: 3728.869,
+        mean: 3729.069,
         longest: 3840,
     },
     StepCost {
         variant: "cube el T=9x9",
-        mean: 3756.138,
+        mean: 3756.28,
         longest: 3880,
     },
     StepCost {
         variant: "cube el T=17x17",
-        mean: 3765.872,
+        mean: 3765.789,
         longest: 3920,
     },
     StepCost {
         variant: "cube ep N=4",
-        mean: 4701.367,
+        mean: 4701.225,
         longest: 6200,
     },
     StepCost {
         variant: "cube ep N=8",
-        mean: 5688.585,
-        longest: 7800,
+        mean: 5688.643,
+        longest: 7760,
     },
     StepCost {
         variant: "cube ep N=16",
-        mean: 7667.48,
+        mean: 7667.603,
         longest: 10760,
     },
     StepCost {
         variant: "cube ep N=32",
-        mean: 11626.807,
-        longest: 16840,
+        mean: 11626.8,
+        longest: 16880,
     },
     StepCost {
         variant: "cube ep T=5x5",
-        mean: 3729.338,
+        mean: 3729.196,
         longest: 3840,
     },
     StepCost {
         variant: "cube ep T=9x9",
-        mean: 3756.48,
+        mean: 3756.92,
         longest: 3880,
     },
     StepCost {
         variant: "cube ep T=17x17",
-        mean: 3766.96,
+        mean: 3766.61,
         longest: 3880,
     },
 ];
