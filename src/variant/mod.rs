@@ -323,7 +323,12 @@ mod tests {
     #[test]
     fn names_are_unique_and_say_what_the_variant_is() {
         for (i, v) in CATALOGUE.iter().enumerate() {
-            let knob = if v.table > 0 {
+            // A table's knob names both sides: the Dahl table's second axis (log2 kappa x_a,
+            // SIDE_Y nodes) is not its first (w, SIDE_W); the cube tables are square.
+            let knob = if v.table > 0 && v.fidelity == Fidelity::DahlSteady {
+                assert_eq!(v.table as usize, crate::model::dahl_table::SIDE_W);
+                format!(" T={}x{}", v.table, crate::model::dahl_table::SIDE_Y)
+            } else if v.table > 0 {
                 format!(" T={}x{}", v.table, v.table)
             } else if v.points > 0 {
                 format!(" N={}", v.points)
