@@ -6,13 +6,15 @@
 //! controller can build one from the controller spec the same way.
 
 use crate::fx::{Q1_31, Q2_30};
+#[cfg(feature = "cube")]
+use crate::model::contact::ContactKind;
 use crate::model::contact::ContactParams;
-#[cfg(feature = "cube")]
-use crate::model::contact::{ContactKind, EStarRule};
+#[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
+use crate::model::contact::EStarRule;
 use crate::model::coulomb::{CoulombConstants, CoulombModel};
-#[cfg(feature = "cube")]
+#[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
 use crate::model::cube::{CubeOptions, CubeParams};
-#[cfg(feature = "cube")]
+#[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
 use crate::model::cube_model::CubeModel;
 #[cfg(feature = "cube")]
 use crate::model::cube_table::CubeTable;
@@ -24,9 +26,9 @@ use crate::model::dahl_steady::DahlModel;
 use crate::model::dahl_table::DahlTable;
 #[cfg(feature = "exp-coulomb")]
 use crate::model::exp_average::ExpCoulombVibrated;
-#[cfg(feature = "cube")]
+#[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
 use crate::model::horn::UPhase;
-#[cfg(feature = "cube")]
+#[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
 use crate::model::quadrature::SlipWindow;
 use crate::model::{FrictionModel, Inversion, ModelError, OperatingPoint};
 use crate::scene::{ModelKind, ModelSpec, RoughSurface, Scene};
@@ -86,8 +88,9 @@ pub enum AnyModel {
     #[cfg(feature = "dahl")]
     Dahl(DahlModel),
     /// Cube model, elastic or elastic-plastic contact ([`ModelKind::CubeElastic`],
-    /// [`ModelKind::CubeElasticPlastic`]).
-    #[cfg(feature = "cube")]
+    /// [`ModelKind::CubeElasticPlastic`]). Not in a bare-metal build without the cargo feature
+    /// `cube-exact`, whose cube scenes run their tables from flash alone.
+    #[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
     Cube(CubeModel),
     /// Cube model tabulated over (ln load, amplitude) and interpolated, with its exact model for
     /// loads outside the table (a model variant only: no scene kind names it;
@@ -131,7 +134,17 @@ impl AnyModel {
                 shape_exponent: spec.dahl_alpha.unwrap_or(1.0),
                 quadrature_points: DAHL_QUADRATURE_POINTS,
             })?)),
-            #[cfg(feature = "cube")]
+            #[cfg(all(
+                feature = "cube",
+                not(any(feature = "cube-exact", not(target_os = "none")))
+            ))]
+            ModelKind::CubeElastic | ModelKind::CubeElasticPlastic => {
+                Err(ModelError::OutOfDomain {
+                    input: "model",
+                    reason: "the exact cube model is not in this build (cargo feature `cube-exact`): only the compiled scenes' tables in flash",
+                })
+            }
+            #[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
             ModelKind::CubeElastic | ModelKind::CubeElasticPlastic => {
                 let horn = scene.horn.ok_or(missing("horn"))?;
                 let surface = spec.surface.ok_or(missing("surface"))?;
@@ -170,10 +183,10 @@ impl AnyModel {
             AnyModel::ExpCoulomb(_) => ModelKind::ExpCoulomb,
             #[cfg(feature = "dahl")]
             AnyModel::Dahl(_) | AnyModel::DahlTable(_) => ModelKind::Dahl,
+            #[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
+            AnyModel::Cube(model) => cube_kind(model.scene().contact().scene().kind),
             #[cfg(feature = "cube")]
-            AnyModel::Cube(model) => cube_kind(model),
-            #[cfg(feature = "cube")]
-            AnyModel::CubeTable(table) => cube_kind(table.exact()),
+            AnyModel::CubeTable(table) => cube_kind(table.contact_kind()),
         }
     }
 }
@@ -186,7 +199,7 @@ impl FrictionModel for AnyModel {
             AnyModel::ExpCoulomb(model) => model.ratio(point, amplitude),
             #[cfg(feature = "dahl")]
             AnyModel::Dahl(model) => model.ratio(point, amplitude),
-            #[cfg(feature = "cube")]
+            #[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
             AnyModel::Cube(model) => model.ratio(point, amplitude),
             #[cfg(feature = "cube")]
             AnyModel::CubeTable(model) => model.ratio(point, amplitude),
@@ -202,7 +215,7 @@ impl FrictionModel for AnyModel {
             AnyModel::ExpCoulomb(model) => model.invert(point, target),
             #[cfg(feature = "dahl")]
             AnyModel::Dahl(model) => model.invert(point, target),
-            #[cfg(feature = "cube")]
+            #[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
             AnyModel::Cube(model) => model.invert(point, target),
             #[cfg(feature = "cube")]
             AnyModel::CubeTable(model) => model.invert(point, target),
@@ -223,7 +236,7 @@ impl FrictionModel for AnyModel {
             AnyModel::ExpCoulomb(model) => model.invert_from(point, target, start),
             #[cfg(feature = "dahl")]
             AnyModel::Dahl(model) => model.invert_from(point, target, start),
-            #[cfg(feature = "cube")]
+            #[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
             AnyModel::Cube(model) => model.invert_from(point, target, start),
             #[cfg(feature = "cube")]
             AnyModel::CubeTable(model) => model.invert_from(point, target, start),
@@ -239,7 +252,7 @@ impl FrictionModel for AnyModel {
             AnyModel::ExpCoulomb(model) => model.load_enters_as_coulomb_force(),
             #[cfg(feature = "dahl")]
             AnyModel::Dahl(model) => model.load_enters_as_coulomb_force(),
-            #[cfg(feature = "cube")]
+            #[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
             AnyModel::Cube(model) => model.load_enters_as_coulomb_force(),
             #[cfg(feature = "cube")]
             AnyModel::CubeTable(model) => model.load_enters_as_coulomb_force(),
@@ -251,8 +264,8 @@ impl FrictionModel for AnyModel {
 
 /// The scene kind of a cube model, from its contact.
 #[cfg(feature = "cube")]
-fn cube_kind(model: &CubeModel) -> ModelKind {
-    match model.scene().contact().scene().kind {
+fn cube_kind(contact: ContactKind) -> ModelKind {
+    match contact {
         ContactKind::Elastic => ModelKind::CubeElastic,
         ContactKind::ElasticPlastic => ModelKind::CubeElasticPlastic,
     }
@@ -276,7 +289,11 @@ pub fn not_compiled(kind: ModelKind) -> ModelError {
     }
 }
 
-#[cfg(any(feature = "dahl", feature = "cube", feature = "exp-coulomb"))]
+#[cfg(any(
+    feature = "dahl",
+    all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))),
+    feature = "exp-coulomb"
+))]
 fn missing(input: &'static str) -> ModelError {
     ModelError::OutOfDomain {
         input,

@@ -99,6 +99,9 @@ mod tests {
     /// none in flash.
     #[test]
     fn the_cube_tables_in_flash_are_the_runtime_builds() {
+        use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
+        use crate::model::cube_table::CubeTable;
+        use crate::model::{FrictionModel, OperatingPoint};
         use crate::variant::fixed::fixed_model;
         use crate::variant::{Family, select};
         let mut tables = 0;
@@ -122,6 +125,40 @@ mod tests {
             let from_flash = fixed_model(scene, variant).expect(scene.name);
             let at_run_time = fixed_model(&copy, variant).expect(scene.name);
             assert_eq!(from_flash, at_run_time, "{}", scene.name);
+            // A bare-metal build without `cube-exact` (the G474's set) builds the table from
+            // the nodes and the variant's contact alone: the same answers over the scene's
+            // stated load range, every amplitude node and between them.
+            let board = CubeTable::from_flash(
+                crate::variant::fixed::contact_kind(variant.fidelity),
+                (scene.contents.load_min_n, scene.contents.load_max_n),
+                side,
+                nodes,
+            )
+            .expect(scene.name);
+            for l in 0..=8 {
+                let (lo, hi) = (scene.contents.load_min_n, scene.contents.load_max_n);
+                let load = lo * libm::pow(hi / lo, f64::from(l) / 8.0);
+                let point = OperatingPoint {
+                    normal_force: Q16_16::from_f64(load).expect("load"),
+                    sliding_velocity: Q8_24::ZERO,
+                };
+                for k in 0..=32 {
+                    let a = Q1_31::from_bits(((k as i64) << 26).min(i32::MAX as i64) as i32);
+                    assert_eq!(
+                        board.ratio(&point, a),
+                        from_flash.ratio(&point, a),
+                        "{} {load} N {k}/32",
+                        scene.name
+                    );
+                }
+                let target = Q2_30::from_f64(0.6).expect("target");
+                assert_eq!(
+                    board.invert(&point, target),
+                    from_flash.invert(&point, target),
+                    "{} {load} N",
+                    scene.name
+                );
+            }
             tables += 1;
         }
         // The horn scenes select the 17 x 17 elastic-plastic table (docs/speed.md).

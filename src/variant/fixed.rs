@@ -15,12 +15,12 @@ use crate::model::AnyModel;
 use crate::model::ModelError;
 use crate::model::any_model::contact_params;
 use crate::model::contact::ContactKind;
-#[cfg(feature = "cube")]
+#[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
 use crate::model::contact::EStarRule;
 use crate::model::coulomb::{CoulombConstants, CoulombModel};
-#[cfg(feature = "cube")]
+#[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
 use crate::model::cube::{CubeOptions, CubeParams};
-#[cfg(feature = "cube")]
+#[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
 use crate::model::cube_model::CubeModel;
 #[cfg(feature = "cube")]
 use crate::model::cube_table::CubeTable;
@@ -29,9 +29,9 @@ use crate::model::dahl::DahlParams;
 use crate::model::dahl_steady::DahlModel;
 #[cfg(feature = "dahl")]
 use crate::model::dahl_table::{DahlGrid, DahlTable};
-#[cfg(feature = "cube")]
+#[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
 use crate::model::horn::UPhase;
-#[cfg(feature = "cube")]
+#[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
 use crate::model::quadrature::SlipWindow;
 use crate::scene::{ModelKind, Scene};
 
@@ -152,7 +152,28 @@ pub fn fixed_model(scene: &Scene<'_>, variant: &Variant) -> Result<AnyModel, Mod
         Fidelity::CubeElastic | Fidelity::CubeElasticPlastic => Err(
             crate::model::any_model::not_compiled(ModelKind::CubeElasticPlastic),
         ),
-        #[cfg(feature = "cube")]
+        // A bare-metal build without the exact cube model (cargo feature `cube-exact`): the
+        // compiled scenes' tables from flash alone, no f64 contact setup at scene start.
+        #[cfg(all(
+            feature = "cube",
+            not(any(feature = "cube-exact", not(target_os = "none")))
+        ))]
+        Fidelity::CubeElastic | Fidelity::CubeElasticPlastic => {
+            let nodes = crate::scene::cube_table_nodes(scene, variant.name)
+                .filter(|_| variant.table > 0)
+                .ok_or(ModelError::OutOfDomain {
+                    input: "variant",
+                    reason: "the exact cube model is not in this build (cargo feature `cube-exact`): only the compiled scenes' tables in flash",
+                })?;
+            let range = (scene.contents.load_min_n, scene.contents.load_max_n);
+            Ok(AnyModel::CubeTable(CubeTable::from_flash(
+                contact_kind(variant.fidelity),
+                range,
+                usize::from(variant.table),
+                nodes,
+            )?))
+        }
+        #[cfg(all(feature = "cube", any(feature = "cube-exact", not(target_os = "none"))))]
         Fidelity::CubeElastic | Fidelity::CubeElasticPlastic => {
             let p = cube_params(scene, variant.fidelity, usize::from(variant.points))?;
             let params = CubeParams {

@@ -31,8 +31,8 @@ pub struct Drive {
 
 impl Drive {
     /// Claims TIM1 with CH1 on PA8 and CH1N on PB13, and configures it for `timing` with the
-    /// outputs off, BRK fed by COMP1, BRK2 by COMP3 and COMP6, TRGO2 triggering the ADC at 3/4
-    /// period, and BDTR locked. The counter runs afterwards (the ADC needs its triggers), the
+    /// outputs off, BRK fed by COMP1, BRK2 by COMP3 and COMP6, CC3 triggering ADC1 at 3/4 of the
+    /// period and TRGO2 (CCR4) ADC2, and BDTR locked. The counter runs afterwards (the ADC needs its triggers), the
     /// outputs do not. Err when TIM1 refused the configuration (it then stays off).
     pub fn new(
         tim: Peri<'static, TIM1>,

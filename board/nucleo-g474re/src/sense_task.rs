@@ -134,23 +134,16 @@ pub async fn run(hw: Hardware) {
             return;
         }
     };
-    if current::running() {
-        // The scan follows the stepped trigger: it may straddle a switching edge.
-        defmt::info!(
-            "ADC1: PA0 normal, PB0 tangential, PA1 current; one scan per TIM1 TRGO2 (the \
-             stepped trigger), {=u32} ns per scan; a triplet every {=u32} PWM periods",
-            config::ADC_SCAN_NS,
-            sensing::TRIGGERS_PER_TRIPLET
-        );
-    } else {
-        defmt::info!(
-            "ADC1: PA0 normal, PB0 tangential, PA1 current; one scan per TIM1 TRGO2, \
-             {=u32} ns per scan in a {=u32} ns quiet window; a triplet every {=u32} PWM periods",
-            config::ADC_SCAN_NS,
-            timing.quiet_window_ns(),
-            sensing::TRIGGERS_PER_TRIPLET
-        );
-    }
+    // ADC1 has its own trigger, TIM1_CC3 at a fixed 3/4 of the period (review finding 4):
+    // the scan stays in the quiet window whatever phase ADC2's stepped CCR4 is at.
+    defmt::info!(
+        "ADC1: PA0 normal, PB0 tangential, PA1 current; one scan per TIM1_CC3 (3/4 of the \
+         period), {=u32} ns per scan in a {=u32} ns quiet window; a triplet every {=u32} PWM \
+         periods",
+        config::ADC_SCAN_NS,
+        timing.quiet_window_ns(),
+        sensing::TRIGGERS_PER_TRIPLET
+    );
 
     // The first triplets, with the drive off, are the current sense's zero (an overrun only
     // loses samples).

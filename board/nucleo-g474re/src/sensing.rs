@@ -1,5 +1,5 @@
-//! Load cells and stack current on ADC1: one scan of the three channels on every TIM1 TRGO2
-//! (every PWM period), DMA into a ring buffer, two scans summed per channel into one triplet of
+//! Load cells and stack current on ADC1: one scan of the three channels on every TIM1_CC3 event
+//! (every PWM period, CCR3 at a fixed 3/4 of the period; ADC2 has TRGO2, stepped), DMA into a ring buffer, two scans summed per channel into one triplet of
 //! 16-bit codes, and the pure sensing chain of `sonolube::sense` on every triplet.
 //!
 //! Plan (register fields in `sonolube_g474_hw::adc`, host-tested): PA0 (ADC1_IN1, normal
@@ -15,7 +15,7 @@ use embassy_stm32::adc::{
 };
 use embassy_stm32::pac;
 use embassy_stm32::peripherals::{ADC1, DMA1_CH1, PA0, PA1, PB0};
-use embassy_stm32::triggers::TIM1_TRGO2;
+use embassy_stm32::triggers::TIM1_CC3;
 use sonolube::fx::{Q1_31, Q16_16};
 use sonolube::sense::{SampleError, SensorChannel};
 use sonolube_g474_hw::adc as plan;
@@ -70,7 +70,7 @@ pub fn start(
         ring,
         Irqs,
         sequence.into_iter(),
-        TIM1_TRGO2,
+        TIM1_CC3,
         Exten::RISING_EDGE,
     );
     plan::program_regular(pac::ADC1, &mut |_| {}).map_err(|_| StartError::AdcRunning)?;

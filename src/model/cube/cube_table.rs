@@ -46,12 +46,20 @@
 //! ([`CubeTable::exact`]). The result is then exact but costs an exact evaluation; nothing is
 //! clamped. [`CubeTable::covers`] tells which path a load takes.
 //!
+//! **From flash alone** ([`CubeTable::from_flash`]): a compiled scene's nodes and its contact
+//! kind, without the exact model. A firmware whose every cube scene is compiled in needs no
+//! more (the cargo feature `cube-exact` off on a bare-metal target: no `f64` contact setup at
+//! scene start, no exact evaluation in flash); a load outside the tabulated range is then an
+//! error (`OutOfDomain` on "normal force"), never a clamp. On a host (tools, tests, the build
+//! script that computes the nodes) the exact model is always compiled.
+//!
 //! Scenes whose u-term can act (off the node with an in-phase u, or the literal window) are
 //! refused at build: F'/F is not monotone in the amplitude there, and the inversion needs it.
 
 use crate::fx::{Q1_31, Q2_30, Q6_26, Q16_16};
 
-use super::contact::{ln_load, ln_load_from_si};
+use super::contact::{ContactKind, ln_load, ln_load_from_si};
+#[cfg(any(feature = "cube-exact", not(target_os = "none")))]
 use super::cube_model::CubeModel;
 use super::fx_error;
 use super::{FrictionModel, Inversion, ModelError, OperatingPoint, Reach};
@@ -64,14 +72,24 @@ pub const MAX_NODES: usize = MAX_SIDE * MAX_SIDE;
 /// Q6.26 bits: 1/8 (a factor e^(1/8) = 1.133 on the load).
 pub const LN_LOAD_MARGIN: i32 = 1 << 23;
 
+/// A load outside the range of a table that has no exact model to fall back to.
+const OUTSIDE_FLASH_TABLE: ModelError = ModelError::OutOfDomain {
+    input: "normal force",
+    reason: "outside the cube table's load range, and this table has no exact model (a table from flash; cargo feature `cube-exact`)",
+};
+
 const ONE_Q30: i64 = 1 << 30;
 const ONE_Q31: i64 = 1 << 31;
 
 /// The cube model tabulated over (ln load, amplitude) for one scene; see the module docs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CubeTable {
-    /// The exact model the nodes come from; used outside the tabulated load range.
-    exact: CubeModel,
+    /// The exact model the nodes come from; used outside the tabulated load range (`None`: a
+    /// table from flash alone, [`CubeTable::from_flash`]).
+    #[cfg(any(feature = "cube-exact", not(target_os = "none")))]
+    exact: Option<CubeModel>,
+    /// The contact model the nodes were computed with.
+    contact_kind: ContactKind,
     /// Nodes per axis: 2^k + 1, 3..=17.
     side: u8,
     /// k = log2(side - 1), 1..=4.
@@ -103,23 +121,23 @@ impl CubeTable {
     /// 3..=17; a load range that is not finite and positive or whose widened ln bounds leave
     /// Q6.26 ([-32, 32)); the exact model's errors at a node; an active u-term or a row that
     /// is not non-increasing in the amplitude.
+    #[cfg(any(feature = "cube-exact", not(target_os = "none")))]
     pub fn new(
         exact: CubeModel,
         load_range_n: (f64, f64),
         side: usize,
     ) -> Result<Self, ModelError> {
-        let mut table = Self::layout(exact, load_range_n, side)?;
+        let mut table = Self::layout(&exact, load_range_n, side)?;
         for row in 0..side {
             let ln = Q6_26::from_bits(table.ln_load_low + row as i32 * table.ln_load_step);
-            let point = table.exact.scene().prepare(ln)?;
+            let point = exact.scene().prepare(ln)?;
             for column in 0..side {
-                let ratio = table
-                    .exact
-                    .ratio_prepared(&point, table.node_amplitude(column))?;
+                let ratio = exact.ratio_prepared(&point, table.node_amplitude(column))?;
                 table.nodes[row * side + column] = ratio.to_bits();
             }
         }
         table.check_rows()?;
+        table.exact = Some(exact);
         Ok(table)
     }
 
@@ -129,13 +147,34 @@ impl CubeTable {
     /// and scene start copies them (about 300 instructions instead of 316,120 for 17 x 17).
     /// Errors: those of [`Self::new`] but the nodes' evaluation, and a node count that is not
     /// `side`^2.
+    #[cfg(any(feature = "cube-exact", not(target_os = "none")))]
     pub fn with_nodes(
         exact: CubeModel,
         load_range_n: (f64, f64),
         side: usize,
         nodes: &[i32],
     ) -> Result<Self, ModelError> {
-        let mut table = Self::layout(exact, load_range_n, side)?;
+        let mut table = Self::layout(&exact, load_range_n, side)?.filled(nodes)?;
+        table.exact = Some(exact);
+        Ok(table)
+    }
+
+    /// The table of a compiled scene from its nodes in flash alone (as [`Self::with_nodes`],
+    /// without the exact model): a load outside the tabulated range is an `OutOfDomain` error
+    /// instead of an exact evaluation. The nodes' u-term and window checks were made when the
+    /// build script computed them. Errors: those of [`Self::with_nodes`].
+    pub fn from_flash(
+        contact_kind: ContactKind,
+        load_range_n: (f64, f64),
+        side: usize,
+        nodes: &[i32],
+    ) -> Result<Self, ModelError> {
+        Self::axes(contact_kind, load_range_n, side)?.filled(nodes)
+    }
+
+    /// This table with `nodes` (`side`^2 of them) copied in and its rows checked.
+    fn filled(mut self, nodes: &[i32]) -> Result<Self, ModelError> {
+        let side = self.side();
         let count = side * side;
         if nodes.len() != count {
             return Err(ModelError::OutOfDomain {
@@ -143,9 +182,9 @@ impl CubeTable {
                 reason: "a table of side S holds S x S nodes",
             });
         }
-        table.nodes[..count].copy_from_slice(nodes);
-        table.check_rows()?;
-        Ok(table)
+        self.nodes[..count].copy_from_slice(nodes);
+        self.check_rows()?;
+        Ok(self)
     }
 
     /// The nodes in use, Q2.30 bits, row-major (`side`^2 of them).
@@ -153,15 +192,15 @@ impl CubeTable {
         &self.nodes[..self.side() * self.side()]
     }
 
-    /// The table of `side` nodes per axis over `load_range_n` with every node 0: the checks and
-    /// the load axis of [`Self::new`].
-    fn layout(exact: CubeModel, load_range_n: (f64, f64), side: usize) -> Result<Self, ModelError> {
-        if !(3..=MAX_SIDE).contains(&side) || !(side - 1).is_power_of_two() {
-            return Err(ModelError::OutOfDomain {
-                input: "table side",
-                reason: "nodes per axis must be 3, 5, 9 or 17",
-            });
-        }
+    /// The table of `side` nodes per axis over `load_range_n` with every node 0 and no exact
+    /// model yet: the checks and the load axis of [`Self::new`].
+    #[cfg(any(feature = "cube-exact", not(target_os = "none")))]
+    fn layout(
+        exact: &CubeModel,
+        load_range_n: (f64, f64),
+        side: usize,
+    ) -> Result<Self, ModelError> {
+        Self::check_side(side)?;
         if exact.scene().has_u_term()
             || exact.scene().quadrature().window() != super::quadrature::SlipWindow::SurfacesApart
         {
@@ -170,6 +209,27 @@ impl CubeTable {
                 reason: "a table needs F'/F monotone in the amplitude: contact at the node, surfaces-apart window",
             });
         }
+        Self::axes(exact.scene().contact().scene().kind, load_range_n, side)
+    }
+
+    /// Nodes per axis must be 2^k + 1 in 3..=17.
+    fn check_side(side: usize) -> Result<(), ModelError> {
+        if !(3..=MAX_SIDE).contains(&side) || !(side - 1).is_power_of_two() {
+            return Err(ModelError::OutOfDomain {
+                input: "table side",
+                reason: "nodes per axis must be 3, 5, 9 or 17",
+            });
+        }
+        Ok(())
+    }
+
+    /// The axes of a table of `side` nodes per axis over `load_range_n`, every node 0.
+    fn axes(
+        contact_kind: ContactKind,
+        load_range_n: (f64, f64),
+        side: usize,
+    ) -> Result<Self, ModelError> {
+        Self::check_side(side)?;
         let (lo, hi) = load_range_n;
         if lo > hi {
             return Err(ModelError::OutOfDomain {
@@ -192,7 +252,9 @@ impl CubeTable {
         let bits = 32 - (step as u32).leading_zeros();
         let reciprocal = ((1u64 << (30 + bits)) + step as u64 / 2) / step as u64; // <= 2^31
         Ok(Self {
-            exact,
+            #[cfg(any(feature = "cube-exact", not(target_os = "none")))]
+            exact: None,
+            contact_kind,
             side: side as u8,
             log2_cells: (side - 1).trailing_zeros() as u8,
             ln_load_low,
@@ -217,9 +279,58 @@ impl CubeTable {
         Ok(())
     }
 
-    /// The exact model the table was built from (and falls back to).
-    pub fn exact(&self) -> &CubeModel {
-        &self.exact
+    /// The exact model the table was built from (and falls back to); `None` for a table from
+    /// flash alone ([`Self::from_flash`]).
+    #[cfg(any(feature = "cube-exact", not(target_os = "none")))]
+    pub fn exact(&self) -> Option<&CubeModel> {
+        self.exact.as_ref()
+    }
+
+    /// The contact model of the nodes (elastic or elastic-plastic).
+    pub fn contact_kind(&self) -> ContactKind {
+        self.contact_kind
+    }
+
+    /// F'/F outside the tabulated load range: the exact model's, or an error for a table
+    /// without one.
+    #[cfg(any(feature = "cube-exact", not(target_os = "none")))]
+    fn ratio_outside(&self, point: &OperatingPoint, amplitude: Q1_31) -> Result<Q2_30, ModelError> {
+        self.exact
+            .as_ref()
+            .ok_or(OUTSIDE_FLASH_TABLE)?
+            .ratio(point, amplitude)
+    }
+
+    /// F'/F outside the tabulated load range: without the exact model in the build, an error.
+    #[cfg(not(any(feature = "cube-exact", not(target_os = "none"))))]
+    fn ratio_outside(&self, _: &OperatingPoint, _: Q1_31) -> Result<Q2_30, ModelError> {
+        Err(OUTSIDE_FLASH_TABLE)
+    }
+
+    /// The inversion outside the tabulated load range: the exact model's, or an error for a
+    /// table without one.
+    #[cfg(any(feature = "cube-exact", not(target_os = "none")))]
+    fn invert_outside(
+        &self,
+        point: &OperatingPoint,
+        target: Q2_30,
+        start: Q1_31,
+    ) -> Result<Inversion, ModelError> {
+        self.exact
+            .as_ref()
+            .ok_or(OUTSIDE_FLASH_TABLE)?
+            .invert_from(point, target, start)
+    }
+
+    /// The inversion outside the tabulated load range: without the exact model, an error.
+    #[cfg(not(any(feature = "cube-exact", not(target_os = "none"))))]
+    fn invert_outside(
+        &self,
+        _: &OperatingPoint,
+        _: Q2_30,
+        _: Q1_31,
+    ) -> Result<Inversion, ModelError> {
+        Err(OUTSIDE_FLASH_TABLE)
     }
 
     /// Nodes per axis.
@@ -337,7 +448,7 @@ impl FrictionModel for CubeTable {
     fn ratio(&self, point: &OperatingPoint, amplitude: Q1_31) -> Result<Q2_30, ModelError> {
         let ln = ln_load(point.normal_force)?;
         let Some(load) = self.load_cell(ln) else {
-            return self.exact.ratio(point, amplitude);
+            return self.ratio_outside(point, amplitude);
         };
         let a = amplitude.convert::<30>().map_err(fx_error("amplitude"))?;
         if a.to_bits() < 0 {
@@ -365,7 +476,7 @@ impl FrictionModel for CubeTable {
     ) -> Result<Inversion, ModelError> {
         let ln = ln_load(point.normal_force)?;
         let Some(load) = self.load_cell(ln) else {
-            return self.exact.invert_from(point, target, start);
+            return self.invert_outside(point, target, start);
         };
         let t = target.to_bits() as i64;
         let last = self.side() - 1;

@@ -32,7 +32,7 @@ fn at(load_n: f64) -> OperatingPoint {
 /// Largest |table - exact| (F'/F) over a dense grid inside the range: 41 loads (geometric)
 /// times 257 amplitudes, none of them on purpose at a node.
 fn worst_error(table: &CubeTable) -> f64 {
-    let exact = table.exact();
+    let exact = table.exact().expect("built with its exact model");
     let mut worst: f64 = 0.0;
     for l in 0..=40 {
         let load = RANGE.0 * libm::pow(RANGE.1 / RANGE.0, f64::from(l) / 40.0);
@@ -55,10 +55,14 @@ fn nodes_are_the_exact_model_exactly() {
             let (low, high) = t.ln_load_range();
             for row in 0..side {
                 let ln = Q6_26::from_bits(low.to_bits() + row as i32 * t.ln_load_step);
-                let prepared = t.exact().scene().prepare(ln).unwrap();
+                let prepared = t.exact().expect("exact").scene().prepare(ln).unwrap();
                 for column in 0..side {
                     let a = t.node_amplitude(column);
-                    let want = t.exact().ratio_prepared(&prepared, a).unwrap();
+                    let want = t
+                        .exact()
+                        .expect("exact")
+                        .ratio_prepared(&prepared, a)
+                        .unwrap();
                     assert_eq!(t.node(row, column), Some(want), "{side} {row} {column}");
                 }
             }
@@ -102,7 +106,7 @@ fn interpolation_error_shrinks_with_the_table_and_meets_its_bound() {
 #[test]
 fn extremes_of_amplitude_and_load() {
     let t = table(ContactKind::ElasticPlastic, 17);
-    let exact = t.exact();
+    let exact = t.exact().expect("built with its exact model");
     let (low, high) = t.ln_load_range();
     for load in [
         RANGE.0,
@@ -137,7 +141,7 @@ fn extremes_of_amplitude_and_load() {
 #[test]
 fn loads_outside_the_range_fall_back_to_the_exact_model() {
     let t = table(ContactKind::ElasticPlastic, 9);
-    let exact = t.exact();
+    let exact = t.exact().expect("built with its exact model");
     for load in [1.0, RANGE.0 / 1.2, RANGE.1 * 1.2, 20_000.0] {
         let p = at(load);
         assert_eq!(t.covers(p.normal_force), Ok(false), "{load}");
@@ -187,7 +191,7 @@ fn ratio_is_monotone_in_amplitude_and_inversion_round_trips() {
                 // Against the exact model's inverse: the interpolation error moved along the
                 // slope (F'/F falls by at least 0.3 per unit amplitude here): a few times the
                 // table's ratio error.
-                let exact = t.exact().invert(&p, target).unwrap();
+                let exact = t.exact().expect("exact").invert(&p, target).unwrap();
                 let shift = (inv.amplitude.to_f64() - exact.amplitude.to_f64()).abs();
                 let limit = match side {
                     3 => 5e-2,
@@ -295,4 +299,61 @@ fn a_table_from_given_nodes_is_the_built_one_and_checks_them() {
         refused,
         Err(ModelError::OutOfDomain { input: "x", .. })
     ));
+}
+
+/// A table from flash alone (the nodes and the contact kind, no exact model: a bare-metal build
+/// without `cube-exact`) answers inside the range exactly as the table it was taken from, and
+/// refuses a load outside it instead of evaluating or clamping.
+#[test]
+fn a_table_from_flash_alone_is_the_built_one_inside_and_refuses_outside() {
+    for kind in [ContactKind::Elastic, ContactKind::ElasticPlastic] {
+        let built = table(kind, 17);
+        let flash = CubeTable::from_flash(kind, RANGE, 17, built.nodes()).unwrap();
+        assert_eq!(flash.exact(), None);
+        assert_eq!(flash.contact_kind(), kind);
+        assert_eq!(flash.nodes(), built.nodes());
+        assert_eq!(flash.ln_load_range(), built.ln_load_range());
+        let target = Q2_30::from_f64(0.7).unwrap();
+        let hint = Q1_31::from_f64(0.4).unwrap();
+        for load in [RANGE.0 / 1.1, RANGE.0, 100.0, RANGE.1, RANGE.1 * 1.1] {
+            let p = at(load);
+            assert_eq!(flash.covers(p.normal_force), Ok(true), "{load}");
+            for k in 0..=16 {
+                let a = Q1_31::from_f64(f64::from(k) / 16.0 * 0.999_999).unwrap();
+                assert_eq!(flash.ratio(&p, a), built.ratio(&p, a), "{load} {k}");
+            }
+            assert_eq!(flash.invert(&p, target), built.invert(&p, target), "{load}");
+            assert_eq!(
+                flash.invert_from(&p, target, hint),
+                built.invert_from(&p, target, hint),
+                "{load}"
+            );
+        }
+        let refused = |result: Result<(), ModelError>| {
+            matches!(
+                result,
+                Err(ModelError::OutOfDomain {
+                    input: "normal force",
+                    ..
+                })
+            )
+        };
+        for load in [1.0, RANGE.0 / 1.2, RANGE.1 * 1.2, 20_000.0] {
+            let p = at(load);
+            assert_eq!(flash.covers(p.normal_force), Ok(false), "{load}");
+            // The table it came from answers there (its exact model); this one refuses.
+            assert!(built.ratio(&p, Q1_31::MAX).is_ok(), "{load}");
+            assert!(refused(flash.ratio(&p, Q1_31::MAX).map(drop)), "{load}");
+            assert!(refused(flash.invert(&p, target).map(drop)), "{load}");
+            assert!(
+                refused(flash.invert_from(&p, target, hint).map(drop)),
+                "{load}"
+            );
+        }
+    }
+    // The nodes are checked as `with_nodes` checks them.
+    let nodes = table(ContactKind::ElasticPlastic, 9).nodes().to_vec();
+    assert!(CubeTable::from_flash(ContactKind::ElasticPlastic, RANGE, 9, &nodes[1..]).is_err());
+    assert!(CubeTable::from_flash(ContactKind::ElasticPlastic, RANGE, 17, &nodes).is_err());
+    assert!(CubeTable::from_flash(ContactKind::ElasticPlastic, RANGE, 6, &nodes).is_err());
 }

@@ -56,7 +56,7 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use sonolube::drive::{Amplitude, DriveTiming};
 
 use crate::Step;
-use crate::adc::{AdcRunning, triggered_cfgr};
+use crate::adc::{AdcRunning, EXTSEL_TIM1_TRGO2, triggered_cfgr};
 use crate::pac::adc::Adc;
 use crate::pac::adc::regs::{Cfgr2, Smpr, Sqr1};
 use crate::pac::adc::vals::SampleTime;
@@ -358,14 +358,14 @@ pub const fn aligned_start(write: usize) -> usize {
     write % RING_LEN / TABLE_LEN * TABLE_LEN
 }
 
-/// Writes ADC2's plan: CFGR (the same trigger set-up as ADC1's, [`triggered_cfgr`]), CFGR2 (no
+/// Writes ADC2's plan: CFGR (ADC1's set-up, [`triggered_cfgr`], on TIM1_TRGO2), CFGR2 (no
 /// oversampling), SMPR1 (IN2 at 2.5 cycles), SQR1 (IN2 alone). Refused ([`AdcRunning`]) while a
 /// regular conversion of ADC2 runs.
 pub fn program_adc(adc: Adc, hook: &mut impl FnMut(Step)) -> Result<(), AdcRunning> {
     if adc.cr().read().adstart() {
         return Err(AdcRunning);
     }
-    let cfgr = triggered_cfgr();
+    let cfgr = triggered_cfgr(EXTSEL_TIM1_TRGO2);
     adc.cfgr().write_value(cfgr);
     hook("ADC2_CFGR");
     adc.cfgr2().write_value(Cfgr2(0));

@@ -4,7 +4,7 @@
 //!
 //! | module | peripherals |
 //! |---|---|
-//! | [`tim1`] | TIM1 (drive, dithering, dead time, break/break2, TRGO2, lock), its clock and pins |
+//! | [`tim1`] | TIM1 (drive, dithering, dead time, break/break2, TRGO2 for ADC2, CC3 for ADC1, lock), its clock and pins |
 //! | [`safe`] | the safe state (MOE cleared, PA8/PB13 driven low as GPIO) |
 //! | [`protect`] | COMP1 + DAC3 (stack current), COMP3 + DAC1 (bus shunt), SYSCFG_CFGR2, DBGMCU |
 //! | [`adc`] | ADC1 regular sequence, trigger, oversampling, DMA mode; DMA1/DMAMUX check |

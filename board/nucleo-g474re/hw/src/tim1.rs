@@ -1,6 +1,7 @@
 //! TIM1 as the half-bridge drive: CH1 (PA8) high side, CH1N (PB13) low side, dithered period
 //! (CR1.DITHEN, 16.4 ARR/CCR), dead time, break from COMP1 (stack current) and break 2 from COMP3
-//! (bus shunt), TRGO2 = OC4REF for the ADC, and BDTR locked in its first write.
+//! (bus shunt), TRGO2 = OC4REF for ADC2's stepped current samples, OC3REF at a fixed 3/4 of the
+//! period for ADC1's load-cell scan (its trigger TIM1_CC3), and BDTR locked in its first write.
 //!
 //! The firmware owns TIM1 entirely (no embassy driver): embassy's `ComplementaryPwm` writes BDTR
 //! (MOE, dead time) in its constructor, and RM0440 freezes the LOCK field at the first write of
@@ -11,8 +12,8 @@
 //! Order of [`configure`] (each step is one register write):
 //! counter stopped, outputs disabled (CCER = 0), PSC, CR2 (idle levels low, MMS2), CCMR1/CCMR2,
 //! AF1/AF2 (break sources), BDTR (once: DTG, OSSI/OSSR, BKE/BKP/BKF, BK2E/BK2P/BK2F, AOE = 0,
-//! MOE = 0, LOCK), CR1 (ARPE, DITHEN, counter still stopped), ARR, CCR1, CCR4, EGR.UG (load the
-//! preloads), SR (flags cleared), CCER (CC1E, CC1NE: driven to the idle level since MOE = 0 and
+//! MOE = 0, LOCK), CR1 (ARPE, DITHEN, counter still stopped), ARR, CCR1, CCR3, CCR4, EGR.UG (load the
+//! preloads), SR (flags cleared), CCER (CC1E, CC1NE, CC3E: driven to the idle level since MOE = 0 and
 //! OSSI = 1), CR1.CEN. Only [`try_enable_outputs`] sets MOE, after all of it.
 
 use sonolube::drive::{Amplitude, DeadTime, DriveTiming};
@@ -36,6 +37,10 @@ const CH1: usize = 0;
 const CCR4: usize = 3;
 /// In CCMR2, CH4 is index 1.
 const CCMR2_CH4: usize = 1;
+/// CH3 (ADC1's trigger, TIM1_CC3) is channel index 2 (CCER, `ccr(2)`) and index 0 in CCMR2.
+/// Like CCR4 it is written raw in the dithered 16.4 format through `ccr(2)`.
+const CH3: usize = 2;
+const CCMR2_CH3: usize = 0;
 /// BRK and BRK2 in the BDTR break field arrays.
 const BRK: usize = 0;
 const BRK2: usize = 1;
@@ -143,8 +148,14 @@ pub fn configure(
     ccmr1.set_ocpe(0, true);
     tim.ccmr_output(0).write_value(ccmr1);
     hook("TIM1_CCMR1");
-    // CH4: PWM mode 2, so OC4REF rises at CCR4 (3/4 period) and TRGO2 starts the ADC there.
+    // CH4: PWM mode 2, so OC4REF rises at CCR4 and TRGO2 starts ADC2 there (stepped by the
+    // current table's DMA). CH3: PWM mode 2 too, OC3REF rising at CCR3, a fixed 3/4 of the
+    // period in the low-side phase: ADC1's load-cell scan (trigger TIM1_CC3) stays in that quiet
+    // window whatever phase CCR4 steps to (review finding 4). Both preloaded, so a compare
+    // changes only at an update event, together with ARR.
     let mut ccmr2 = CcmrOutputGp16(0);
+    ccmr2.set_ocm(CCMR2_CH3, Ocm::PWM_MODE2);
+    ccmr2.set_ocpe(CCMR2_CH3, true);
     ccmr2.set_ocm(CCMR2_CH4, Ocm::PWM_MODE2);
     ccmr2.set_ocpe(CCMR2_CH4, true);
     tim.ccmr_output(1).write_value(ccmr2);
@@ -180,6 +191,10 @@ pub fn configure(
     let mut ccer = CcerAdv(0);
     ccer.set_cce(CH1, true);
     ccer.set_ccne(CH1, true);
+    // CC3E: so that ADC1's TIM1_CC3 trigger does not depend on whether RM0440's CC3 event is
+    // taken before or after the output enable. OC3 reaches no pin: PA10 (TIM1_CH3) stays in
+    // its reset analog mode (no AF6), and with MOE = 0 the output is at its idle level anyway.
+    ccer.set_cce(CH3, true);
     tim.ccer().write_value(ccer);
     hook("TIM1_CCER");
     tim.cr1().modify(|w| w.set_cen(true));
@@ -233,7 +248,7 @@ pub fn connect_pins(gpioa: Gpio, gpiob: Gpio, hook: &mut impl FnMut(Step)) {
     }
 }
 
-/// ARR, CCR1 and CCR4 for `timing` at `amplitude`, without guarding the update event (the
+/// ARR, CCR1, CCR3 and CCR4 for `timing` at `amplitude`, without guarding the update event (the
 /// counter is stopped during [`configure`]; [`write_timing`] guards it).
 fn write_period_registers(
     tim: TimAdv,
@@ -247,14 +262,17 @@ fn write_period_registers(
     tim.ccr_dither(CH1)
         .write_value(CcrDither1ch(timing.duty_compare(amplitude)));
     hook("TIM1_CCR1");
+    tim.ccr(CH3)
+        .write_value(Ccr1ch(timing.adc_trigger_compare()));
+    hook("TIM1_CCR3");
     tim.ccr(CCR4)
         .write_value(Ccr1ch(timing.adc_trigger_compare()));
     hook("TIM1_CCR4");
 }
 
-/// Switches period, duty and ADC trigger together: update events are disabled (CR1.UDIS = 1)
-/// while ARR, CCR1 and CCR4 are written, so the preload registers are never transferred with a
-/// new ARR and an old CCR; the next period boundary after UDIS = 0 takes all three. Refused,
+/// Switches period, duty and ADC triggers together: update events are disabled (CR1.UDIS = 1)
+/// while ARR, CCR1, CCR3 and CCR4 are written, so the preload registers are never transferred
+/// with a new ARR and an old CCR; the next period boundary after UDIS = 0 takes all four. Refused,
 /// with nothing written, when `timing`'s dead time is not the one locked in BDTR (the dead time
 /// is written only by [`configure`], with MOE = 0).
 pub fn write_timing(
@@ -287,8 +305,8 @@ pub enum UpdateEvents {
     OneSuppressed,
 }
 
-/// [`write_timing`] for the stepped ADC trigger ([`crate::current`]): ARR and CCR1 under
-/// CR1.UDIS, CCR4 left to the DMA table except that its preload is pulled below
+/// [`write_timing`] for the stepped ADC trigger ([`crate::current`]): ARR, CCR1 and CCR3
+/// (ADC1's fixed trigger at 3/4 of the new period, below the new ARR) under CR1.UDIS, CCR4 left to the DMA table except that its preload is pulled below
 /// `ccr4_limit` (dithered format; [`crate::current::trigger_limit`] of the old and new ARR)
 /// when it is not already: the preload holds an entry for the old period, which the next
 /// update makes active under the new ARR, and an entry at or above the new ARR never makes
@@ -321,6 +339,9 @@ pub fn write_timing_stepped(
     tim.ccr_dither(CH1)
         .write_value(CcrDither1ch(timing.duty_compare(amplitude)));
     hook("TIM1_CCR1");
+    tim.ccr(CH3)
+        .write_value(Ccr1ch(timing.adc_trigger_compare()));
+    hook("TIM1_CCR3");
     // CCR4 (channel index 3) in the dithered format, as the table's DMA writes it.
     let preloaded = tim.ccr(3).read().0;
     if preloaded >= ccr4_limit {

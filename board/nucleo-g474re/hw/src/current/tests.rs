@@ -171,9 +171,8 @@ fn simulate(
     rewrite: Option<(usize, u32)>,
 ) -> Vec<usize> {
     let mut memory = dma_order(phases, 0);
-    // `start`: CCR4 = phase 0, UG (active = phase 0), CCR4 = phase 1 in the preload.
-    let mut active = phases[0];
-    let mut preload = phases[1];
+    // Where `start` leaves CCR4, read from its register writes, not assumed.
+    let (mut active, mut preload) = started_ccr4(phases);
     let mut transfers = 0usize;
     let mut sampled = Vec::new();
     for period in 0..periods {
@@ -191,6 +190,51 @@ fn simulate(
         }
     }
     sampled
+}
+
+/// CCR4's active and preload values as [`start`] leaves them, from its writes on the register
+/// images (RM0440, advanced-control timers): the software update (EGR.UG) transfers CCR4's
+/// preload to the active register, with UDE clear so that no DMA request follows it; the CCR4
+/// written after UG stays in the preload until the first update event of the running counter.
+/// So the two-period lead of the table ([`TABLE_LEAD`]) is not put into the model: it follows
+/// from these two values and RM0440's order at each update (transfer, then the update's DMA
+/// request writes the preload).
+fn started_ccr4(phases: &[u32; 4]) -> (u32, u32) {
+    let mut images = Images::new();
+    let addresses = Addresses {
+        adc_dr: 0x5000_0140,
+        tim1_ccr4: 0x4001_2C40,
+        ring: 0x2000_1000,
+        table: 0x2000_2000,
+    };
+    let tim_image = &*images.tim as *const Image;
+    // SAFETY: the images outlive the handles.
+    let (tim, adc, dma, mux) = unsafe {
+        (
+            TimAdv::from_ptr(images.tim.ptr()),
+            Adc::from_ptr(images.adc.ptr()),
+            Dma::from_ptr(images.dma.ptr()),
+            Dmamux::from_ptr(images.mux.ptr()),
+        )
+    };
+    let mut at_ug = None;
+    start(tim, adc, dma, mux, &addresses, phases, &mut |step| {
+        if step == "TIM1_EGR" {
+            // SAFETY: the image is alive; read only between the accessors' writes.
+            let (ccr4, dier) =
+                unsafe { ((*tim_image).word(TIM_CCR4), (*tim_image).word(TIM_DIER)) };
+            at_ug = Some((ccr4, dier));
+        }
+    })
+    .unwrap();
+    let (active, dier_at_ug) = at_ug.expect("start generates an update (EGR.UG)");
+    assert_eq!(dier_at_ug & (1 << 8), 0, "UDE clear at UG");
+    assert_eq!(
+        images.tim.word(TIM_CR1) & 1,
+        1,
+        "the counter runs after start"
+    );
+    (active, images.tim.word(TIM_CCR4))
 }
 
 #[test]
@@ -635,12 +679,13 @@ impl Trigger {
         crate::tim1::configure(tim, timing, &mut |_| {}).unwrap();
         let arr = timing.period().arr_register();
         let phases = phase_table(arr, timing.duty_compare(amplitude)).unwrap();
-        image.set_word(TIM_CCR4, phases[1]);
+        let (active, preload) = started_ccr4(&phases);
+        image.set_word(TIM_CCR4, preload);
         store_table(table, &dma_order(&phases, 0));
         Self {
             image,
             arr_active: arr,
-            ccr4_active: phases[0],
+            ccr4_active: active,
             transfers: 0,
             periods: 0,
             conversions: Vec::new(),

@@ -18,6 +18,7 @@ const CCER: usize = 0x20;
 const PSC: usize = 0x28;
 const ARR: usize = 0x2C;
 const CCR1_OFFSET: usize = 0x34;
+const CCR3_OFFSET: usize = 0x3C;
 const CCR4_OFFSET: usize = 0x40;
 const BDTR: usize = 0x44;
 const AF1: usize = 0x60;
@@ -48,6 +49,12 @@ fn configured(hz: u32) -> Box<Image> {
     image
 }
 
+/// Whether a dithered CCR lies at 3/4 of the period a dithered ARR gives, to one sixteenth of
+/// a tick: RM0440's dithering makes the period `ARR + 16` sixteenths.
+fn three_quarters_of_the_period(arr: u32, ccr: u32) -> bool {
+    (4 * i64::from(ccr) - 3 * i64::from(arr + 16)).abs() <= 4
+}
+
 /// Average PWM frequency of a dithered ARR, mHz: the period is `ARR + 16` sixteenths of a tick
 /// (RM0440, dithering: `ARR[19:4] + 1` ticks plus `ARR[3:0]` sixteenths).
 fn effective_millihertz(arr: u32) -> f64 {
@@ -73,12 +80,21 @@ fn configure_writes_the_reference_manuals_fields() {
     assert_eq!(image.bits(CCMR1, 4, 3), 0b110, "OC1M");
     assert!(!image.bit(CCMR1, 16), "OC1M[3]");
     assert!(image.bit(CCMR1, 3), "OC1PE");
-    // CCMR2: CH4 PWM mode 2 (OC4M = 0111), preload.
+    // CCMR2: CH3 and CH4 PWM mode 2 (OCxM = 0111: inactive below CCRx, so OCxREF rises at
+    // CCRx when up-counting), preloaded; CH3 at bits 0-7 and 16, CH4 at 8-15 and 24.
+    assert_eq!(image.bits(CCMR2, 0, 2), 0, "CC3S output");
+    assert_eq!(image.bits(CCMR2, 4, 3), 0b111, "OC3M");
+    assert!(!image.bit(CCMR2, 16), "OC3M[3]");
+    assert!(image.bit(CCMR2, 3), "OC3PE");
     assert_eq!(image.bits(CCMR2, 12, 3), 0b111, "OC4M");
     assert!(!image.bit(CCMR2, 24), "OC4M[3]");
     assert!(image.bit(CCMR2, 11), "OC4PE");
     // CCER: CH1 and CH1N enabled, active high.
     assert_eq!(image.bits(CCER, 0, 4), 0b0101, "CC1E, CC1P, CC1NE, CC1NP");
+    // CH3 enabled, active high, no complementary output (CCER bits 8-11), CH2 and CH4 off.
+    assert_eq!(image.bits(CCER, 8, 4), 0b0001, "CC3E, CC3P, CC3NE, CC3NP");
+    assert_eq!(image.bits(CCER, 4, 4), 0, "CH2");
+    assert_eq!(image.bits(CCER, 12, 4), 0, "CH4");
     assert_eq!(image.word(PSC), 0);
     // BDTR.
     let t = timing(40_000);
@@ -114,6 +130,12 @@ fn configure_writes_the_reference_manuals_fields() {
     assert_eq!(image.word(ARR), t.period().arr_register());
     assert_eq!(image.word(CCR1_OFFSET), t.duty_compare(Amplitude::ZERO));
     assert_eq!(image.word(CCR4_OFFSET), t.adc_trigger_compare());
+    // CCR3 at 3/4 of the period in RM0440's dithered format (the period is ARR + 16
+    // sixteenths of a tick), to the sixteenth.
+    assert!(three_quarters_of_the_period(
+        image.word(ARR),
+        image.word(CCR3_OFFSET)
+    ));
     assert!(image.bit(EGR, 0), "UG");
     assert_eq!(image.word(SR), 0);
 }
@@ -184,6 +206,7 @@ fn configure_order_moe_stays_off_and_bdtr_is_written_once() {
             "TIM1_CR1",
             "TIM1_ARR",
             "TIM1_CCR1",
+            "TIM1_CCR3",
             "TIM1_CCR4",
             "TIM1_EGR",
             "TIM1_SR",
@@ -495,22 +518,35 @@ fn the_stepped_timing_write_leaves_ccr4_to_the_dma_and_finds_a_suppressed_update
     let names: Vec<Step> = steps.iter().map(|(s, _)| *s).collect();
     assert_eq!(
         names,
-        ["TIM1_SR", "TIM1_CR1", "TIM1_ARR", "TIM1_CCR1", "TIM1_CR1"]
+        [
+            "TIM1_SR",
+            "TIM1_CR1",
+            "TIM1_ARR",
+            "TIM1_CCR1",
+            "TIM1_CCR3",
+            "TIM1_CR1"
+        ]
     );
     let new = timing(47_000);
     let half = Amplitude::from_ratio(1, 2).unwrap();
-    let last = &steps[4].1;
+    let last = &steps[5].1;
     assert_eq!(word(last, ARR), new.period().arr_register());
     assert_eq!(word(last, CCR1_OFFSET), new.duty_compare(half));
+    // ADC1's trigger moves with the period, inside the same UDIS window: 3/4 of the new one.
+    assert!(three_quarters_of_the_period(
+        word(last, ARR),
+        word(last, CCR3_OFFSET)
+    ));
     // CCR4 is the table's: configure's 3/4 trigger at 40 kHz is still there (below the new
     // ARR, so not pulled down).
     assert_eq!(
         word(last, CCR4_OFFSET),
         timing(40_000).adc_trigger_compare()
     );
-    // UDIS (CR1 bit 1) set before ARR and cleared after CCR1.
+    // UDIS (CR1 bit 1) set before ARR and cleared after CCR1 and CCR3.
     assert_eq!(word(&steps[2].1, CR1) & 0b10, 0b10);
     assert_eq!(word(&steps[3].1, CR1) & 0b10, 0b10);
+    assert_eq!(word(&steps[4].1, CR1) & 0b10, 0b10);
     assert_eq!(word(last, CR1) & 0b10, 0);
     // The SR write clears UIF (bit 0) alone: BIF, B2IF, SBIF and the others are written 1.
     let sr_written = SR_CLEAR_UIF;
