@@ -89,6 +89,9 @@ impl ResonanceSettings {
         let tracker = TrackerSettings {
             min_hz: search.min_hz,
             max_hz: search.max_hz,
+            integral_per_s: TrackerSettings::OPERATION
+                .on_resonator(stack.resonance_hz, stack.quality_factor)
+                .integral_per_s,
             max_rate_hz_per_s: 500_000.0,
             ..TrackerSettings::OPERATION
         };

@@ -283,11 +283,11 @@ pub const RESONATOR_Q: [f64; 5] = [30.0, 60.0, 100.0, 200.0, 300.0];
 /// - the settle limit is max(the scene's, 2 tau), tau = 2 Q / w0 = Q / (pi f0), the envelope
 ///   time constant (physics-notes §7);
 /// - the scene's timeline (its profiles' and targets' points after t = 0, its fault events and
-///   its criteria windows, and its duration) moves later by as much as the search's rule
-///   needs to lock before the scene's first judged instant
-///   ([`sonolube::scene::feasibility::search_timing`]): the friction loop starts at the
-///   lock, and a search on a slow envelope takes longer (105 ms at 20 kHz, Q 300:
-///   docs/resonance.md).
+///   its criteria windows, and its duration) moves later by the time the search's rule
+///   allows it to lock ([`sonolube::resonance::ResonanceSettings::search_lock_bound_s`]):
+///   the friction loop starts at the lock, so the scene's own start-up before its first
+///   step (the loop's ramp) comes after it, and a search on a slow envelope takes longer
+///   (105 ms at 20 kHz, Q 300: docs/resonance.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Resonator {
     /// Resonance f0, Hz.
@@ -310,8 +310,8 @@ pub struct Resonator {
     pub settle_s: f64,
     /// The search's time to lock by its rule, s (f0 anywhere in its +-10 % band).
     pub search_lock_s: f64,
-    /// How much later the scene's timeline runs, s (0 when the search locks before the
-    /// scene's first judged instant).
+    /// How much later the scene's timeline runs, s: the search's time, in whole control
+    /// periods.
     pub lead_s: f64,
 }
 
@@ -367,11 +367,12 @@ impl Resonator {
             .map_err(|e| {
                 format!("no resonance search at {resonance_hz} Hz, Q {quality_factor}: {e:?}")
             })?;
-        let first_step_s = sonolube::scene::feasibility::first_judged_s(scene);
-        // Whole control periods, so that the moved events fall on the same phase of the
-        // control step as the scene's.
+        // The friction loop starts at the lock: the scene's own start (its t = 0, where a
+        // pinned run starts its loop and ramps up before the first step) moves there. Whole
+        // control periods, so that the moved events fall on the same phase of the control
+        // step as the scene's.
         let period_s = 1.0 / scene.control_rate_hz;
-        let lead_s = (((search_lock_s - first_step_s) / period_s).ceil() * period_s).max(0.0);
+        let lead_s = (search_lock_s / period_s).ceil() * period_s;
         Ok(Self {
             search_lock_s,
             lead_s,
@@ -640,8 +641,8 @@ fn resonator_sweep(scene: &Scene<'_>, seeds: &[u64], jobs: usize) -> Result<Done
     println!(
         "  (reach: the largest reduction the plant's steady state gives at full scale at the \
          scene's first load and speed; search: the time the resonance search's rule allows it \
-         to lock, f0 anywhere in +-10 %; later: how much later the scene's timeline runs so that \
-         its first step comes after it; limit: time with the drive at its ceiling)"
+         to lock, f0 anywhere in +-10 %; later: how much later the scene's timeline runs, the \
+         friction loop starting at the lock; limit: time with the drive at its ceiling)"
     );
     let stats = criterion_stats(scene, &runs, &results);
     print!("{}", stats_table(&stats));
@@ -946,8 +947,9 @@ mod tests {
                 );
                 let adapted = r.adapt(scene);
                 let run = r.apply(scene, &adapted);
-                // The first step comes after the search's rule allows it to lock.
-                assert!(run.target[1].at_s >= r.search_lock_s - 1e-12);
+                // The scene's start-up comes after the search's rule allows it to lock.
+                assert!(r.lead_s >= r.search_lock_s && r.lead_s < r.search_lock_s + 1e-4);
+                assert!((run.target[1].at_s - scene.target[1].at_s - r.lead_s).abs() < 1e-12);
                 assert_eq!(run.duration_s - scene.duration_s, r.lead_s);
                 assert!(run.transducer.shift.freq_auto && run.transducer.shift.bvd_envelope);
                 assert_eq!(run.transducer.drive_hz, f0);
