@@ -391,12 +391,7 @@ impl Resonator {
     /// `scene` on this resonator, its criteria and timeline replaced by `adapted`
     /// ([`Self::adapt`]).
     pub fn apply<'a>(&self, scene: &Scene<'a>, adapted: &'a Adapted) -> Scene<'a> {
-        let mut s = *scene;
-        s.duration_s = scene.duration_s + self.lead_s;
-        s.normal_load_n = &adapted.normal_load_n;
-        s.sliding_velocity_m_per_s = &adapted.sliding_velocity_m_per_s;
-        s.target = &adapted.target;
-        s.faults = &adapted.faults;
+        let mut s = adapted.apply(scene, self.lead_s);
         s.transducer.resonance_hz = self.resonance_hz;
         s.transducer.drive_hz = self.resonance_hz;
         s.transducer.quality_factor = self.quality_factor;
@@ -405,73 +400,13 @@ impl Resonator {
         s.transducer.shift.freq_auto = true;
         s.actuator.full_scale_voltage_v = self.full_scale_voltage_v;
         s.actuator.full_scale_amplitude_m = self.full_scale_amplitude_m;
-        s.criteria = &adapted.criteria;
         s
     }
 
     /// The scene's criteria with the settle limit at [`Self::settle_s`], and its timeline
     /// from its first event on later by [`Self::lead_s`].
     pub fn adapt(&self, scene: &Scene<'_>) -> Adapted {
-        let lead = self.lead_s;
-        let later = |t: f64| if t > 0.0 { t + lead } else { t };
-        let breakpoints = |points: &[Breakpoint]| -> Vec<Breakpoint> {
-            points
-                .iter()
-                .map(|p| Breakpoint {
-                    t_s: later(p.t_s),
-                    ..*p
-                })
-                .collect()
-        };
-        Adapted {
-            criteria: scene
-                .criteria
-                .iter()
-                .map(|c| match *c {
-                    Criterion::Settle { band_pct, .. } => Criterion::Settle {
-                        band_pct,
-                        within_s: self.settle_s,
-                    },
-                    Criterion::SteadyRmsError {
-                        max_pct,
-                        from_s,
-                        to_s,
-                    } => Criterion::SteadyRmsError {
-                        max_pct,
-                        from_s: from_s + lead,
-                        to_s: to_s + lead,
-                    },
-                    Criterion::TrackingError {
-                        max_pct,
-                        from_s,
-                        to_s,
-                    } => Criterion::TrackingError {
-                        max_pct,
-                        from_s: from_s + lead,
-                        to_s: to_s + lead,
-                    },
-                    other => other,
-                })
-                .collect(),
-            normal_load_n: breakpoints(scene.normal_load_n),
-            sliding_velocity_m_per_s: breakpoints(scene.sliding_velocity_m_per_s),
-            target: scene
-                .target
-                .iter()
-                .map(|p| TargetPoint {
-                    at_s: later(p.at_s),
-                    ..*p
-                })
-                .collect(),
-            faults: scene
-                .faults
-                .iter()
-                .map(|f| FaultEvent {
-                    at_s: later(f.at_s),
-                    ..*f
-                })
-                .collect(),
-        }
+        shifted(scene, self.lead_s, Some(self.settle_s))
     }
 
     /// Why this resonator cannot do what `scene` asks within the stack's ratings, if so:
@@ -514,6 +449,101 @@ impl Resonator {
             self.quality_factor
         )
     }
+}
+
+impl Adapted {
+    /// `scene` with these criteria and this timeline, its duration `lead_s` longer (the lead
+    /// [`shifted`] was given).
+    pub fn apply<'a>(&'a self, scene: &Scene<'a>, lead_s: f64) -> Scene<'a> {
+        Scene {
+            duration_s: scene.duration_s + lead_s,
+            normal_load_n: &self.normal_load_n,
+            sliding_velocity_m_per_s: &self.sliding_velocity_m_per_s,
+            target: &self.target,
+            faults: &self.faults,
+            criteria: &self.criteria,
+            ..*scene
+        }
+    }
+}
+
+/// `scene`'s criteria and timeline for a `freq auto` run whose friction loop starts at the
+/// search's lock: every point after t = 0 of its profiles, targets and faults, and its
+/// criteria windows, later by `lead` s; the settle limit replaced by `settle_s` if given.
+/// [`search_lead_s`] gives the lead the search's rule needs (other sweeps that run `freq auto`
+/// on a scene written for a pinned drive can use both).
+pub fn shifted(scene: &Scene<'_>, lead: f64, settle_s: Option<f64>) -> Adapted {
+    let later = |t: f64| if t > 0.0 { t + lead } else { t };
+    let breakpoints = |points: &[Breakpoint]| -> Vec<Breakpoint> {
+        points
+            .iter()
+            .map(|p| Breakpoint {
+                t_s: later(p.t_s),
+                ..*p
+            })
+            .collect()
+    };
+    Adapted {
+        criteria: scene
+            .criteria
+            .iter()
+            .map(|c| match *c {
+                Criterion::Settle { band_pct, within_s } => Criterion::Settle {
+                    band_pct,
+                    within_s: settle_s.unwrap_or(within_s),
+                },
+                Criterion::SteadyRmsError {
+                    max_pct,
+                    from_s,
+                    to_s,
+                } => Criterion::SteadyRmsError {
+                    max_pct,
+                    from_s: from_s + lead,
+                    to_s: to_s + lead,
+                },
+                Criterion::TrackingError {
+                    max_pct,
+                    from_s,
+                    to_s,
+                } => Criterion::TrackingError {
+                    max_pct,
+                    from_s: from_s + lead,
+                    to_s: to_s + lead,
+                },
+                other => other,
+            })
+            .collect(),
+        normal_load_n: breakpoints(scene.normal_load_n),
+        sliding_velocity_m_per_s: breakpoints(scene.sliding_velocity_m_per_s),
+        target: scene
+            .target
+            .iter()
+            .map(|p| TargetPoint {
+                at_s: later(p.at_s),
+                ..*p
+            })
+            .collect(),
+        faults: scene
+            .faults
+            .iter()
+            .map(|f| FaultEvent {
+                at_s: later(f.at_s),
+                ..*f
+            })
+            .collect(),
+    }
+}
+
+/// The time `freq auto`'s search needs on `scene`'s declared stack by its rule
+/// ([`sonolube::resonance::ResonanceSettings::search_lock_bound_s`]), in whole control
+/// periods: the lead [`shifted`] gives a scene so that its own start comes after the lock.
+pub fn search_lead_s(scene: &Scene<'_>) -> Result<f64, String> {
+    let stack = sonolube::station::scene_stack(scene);
+    let lock_s = sonolube::resonance::ResonanceSettings::around(&stack)
+        .search_lock_bound_s()
+        .map_err(|e| format!("no resonance search on the scene's stack: {e:?}"))?;
+    let period_s = 1.0 / scene.control_rate_hz;
+    Ok((lock_s / period_s).ceil() * period_s)
 }
 
 /// The resonator sweep: the scene on every (f0, Q) of [`RESONATOR_F0_HZ`] x [`RESONATOR_Q`]
