@@ -159,6 +159,19 @@ const NO_CURRENT_IN_SCENE: &str = "the scene has no current sensing (bvd_envelop
 /// board's simulated sense is the same).
 pub const CURRENT_SENSE_A_PER_FULL_SCALE: f64 = 6.6;
 
+/// What the resonance loop believes about `scene`'s stack: its declared f0, Q, C0 and full
+/// scale on this board's current sense.
+pub fn scene_stack(scene: &Scene<'_>) -> StackSettings {
+    StackSettings {
+        resonance_hz: scene.transducer.resonance_hz,
+        quality_factor: scene.transducer.quality_factor,
+        clamped_capacitance_f: scene.transducer.clamped_capacitance_f,
+        full_scale_voltage_v: scene.actuator.full_scale_voltage_v,
+        amperes_per_full_scale: CURRENT_SENSE_A_PER_FULL_SCALE,
+        min_admittance_s: StackSettings::REFERENCE.min_admittance_s,
+    }
+}
+
 /// The timer the resonance loop's frequencies are rounded to (TIM1 of the G474 at 170 MHz;
 /// the QEMU board's simulated drive uses the same grid).
 pub const DRIVE_CLOCK: TimerClock = TimerClock::G474_TIM1;
@@ -219,14 +232,7 @@ impl Station {
         tangential: SensorChannel,
     ) -> Result<Self, StationError> {
         let controller = Controller::new(Config::new(settings).map_err(StationError::Config)?);
-        let stack = StackSettings {
-            resonance_hz: scene.transducer.resonance_hz,
-            quality_factor: scene.transducer.quality_factor,
-            clamped_capacitance_f: scene.transducer.clamped_capacitance_f,
-            full_scale_voltage_v: scene.actuator.full_scale_voltage_v,
-            amperes_per_full_scale: CURRENT_SENSE_A_PER_FULL_SCALE,
-            min_admittance_s: StackSettings::REFERENCE.min_admittance_s,
-        };
+        let stack = scene_stack(scene);
         let start = Frequency::from_millihertz(libm::round(scene.transducer.drive_hz * 1e3) as u32);
         let resonance =
             ResonanceLoop::new(&ResonanceSettings::around(&stack), start, DRIVE_CLOCK).ok();

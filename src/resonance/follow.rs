@@ -89,6 +89,9 @@ impl ResonanceSettings {
         let tracker = TrackerSettings {
             min_hz: search.min_hz,
             max_hz: search.max_hz,
+            integral_per_s: TrackerSettings::OPERATION
+                .on_resonator(stack.resonance_hz, stack.quality_factor)
+                .integral_per_s,
             max_rate_hz_per_s: 500_000.0,
             ..TrackerSettings::OPERATION
         };
@@ -97,6 +100,24 @@ impl ResonanceSettings {
             search,
             tracker,
         }
+    }
+
+    /// The search's configuration as [`ResonanceLoop::new`] builds it: its dwell, overrun
+    /// and hold reckoned in synchronous windows of four PWM periods at the nominal f0.
+    fn search_config(&self) -> Result<SearchConfig, ResonanceError> {
+        let nominal_hz = libm::round(self.stack.resonance_hz) as u32;
+        let windows_in_periods = LockInConfig {
+            sample_rate_hz: nominal_hz,
+            periods_per_window: SYNCHRONOUS_SAMPLES_PER_TURN as u16,
+            sense_delay_ns: 0,
+        };
+        SearchConfig::new(&self.search, &self.stack, &windows_in_periods)
+    }
+
+    /// The time `freq auto`'s search takes to lock by its rule, s, for any f0 in its band
+    /// ([`SearchConfig::lock_bound_s`]). Errors: those of [`ResonanceLoop::new`].
+    pub fn search_lock_bound_s(&self) -> Result<f64, ResonanceError> {
+        Ok(self.search_config()?.lock_bound_s())
     }
 }
 
@@ -191,11 +212,7 @@ impl ResonanceLoop {
         // The search reckons its dwell, overrun and lock hold in windows of
         // `periods_per_window` drive periods: a synchronous window of one reference turn is
         // four PWM periods.
-        let windows_in_periods = LockInConfig {
-            periods_per_window: (SYNCHRONOUS_SAMPLES_PER_TURN) as u16,
-            ..lock_in
-        };
-        let search = SearchConfig::new(&settings.search, &settings.stack, &windows_in_periods)?;
+        let search = settings.search_config()?;
         let tracker = TrackerConfig::new(&settings.tracker, stack, nominal_hz)?;
         let tuning = Tuning::nearest(start, clock)?;
         let mut lock_in = LockIn::synchronous(lock_in, tuning.frequency, SYNCHRONOUS_PHASE_STEP)?;
@@ -313,8 +330,14 @@ impl ResonanceLoop {
             },
             Stage::Tracking { tracker, unlocked } => match tracker.update(window, amplitude) {
                 Ok(status) => {
+                    // With the drive off nothing is measured and the frequency holds: such
+                    // windows do not count toward a lost resonance (the friction loop may ask
+                    // for no vibration for as long as it likes after the search locked;
+                    // before, 200 such windows latched `resonance-lost`).
                     *unlocked = if status.locked {
                         0
+                    } else if amplitude == Amplitude::ZERO {
+                        *unlocked
                     } else {
                         unlocked.saturating_add(1)
                     };

@@ -86,8 +86,10 @@ pub use ringdown::{
     RING_DOWN_SPAN_TIME_CONSTANTS, RingDownError, RingDownFit, RingDownSums, fit_ring_down,
     group_amplitude_lsb, group_amplitude_squared,
 };
-pub use search::{Lock, Search, SearchConfig, SearchSettings, SearchStep};
+pub use search::{
+    Lock, SWEEP_LAG_BANDWIDTHS, Search, SearchConfig, SearchSettings, SearchStep, pull_in_time_s,
+};
 pub use stack::{StackModel, StackSettings};
 pub use sweep::{Sweep, SweepPlan, SweepPoint, SweepProgress, SweepResult};
-pub use tracker::{TrackStatus, Tracker, TrackerConfig, TrackerSettings};
+pub use tracker::{LOOP_DAMPING, TrackStatus, Tracker, TrackerConfig, TrackerSettings};
 pub use tuning::Tuning;

@@ -62,11 +62,15 @@ pub struct SearchSettings {
 
 impl SearchSettings {
     /// A search for `stack` over f0 `(1 +- relative_band)` (clamped to 20-60 kHz) at a tenth
-    /// of full amplitude, coarse points one bandwidth apart (`1 / Q`), one window settled and
-    /// one measured per point, ending two points past the conductance's peak once it has
-    /// halved, pull-in with [`TrackerSettings::PULL_IN`] for at most 6 ms.
+    /// of full amplitude, coarse points one bandwidth apart (`1 / Q`), at least one window
+    /// settled and one measured per point (more on a slow envelope: [`SearchConfig::new`]),
+    /// ending two points past the conductance's peak once it has halved, pull-in with
+    /// [`TrackerSettings::PULL_IN`] with its gains from the envelope
+    /// ([`TrackerSettings::on_resonator`]) for at most twice the pull-in the loop predicts
+    /// ([`pull_in_time_s`]).
     pub fn around(stack: &StackSettings, relative_band: f64) -> Self {
         let f0 = stack.resonance_hz;
+        let pull_in = TrackerSettings::PULL_IN.on_resonator(f0, stack.quality_factor);
         Self {
             min_hz: (f0 * (1.0 - relative_band)).max(20_000.0),
             max_hz: (f0 * (1.0 + relative_band)).min(60_000.0),
@@ -75,10 +79,35 @@ impl SearchSettings {
             settle_windows: 1,
             measure_windows: 1,
             stop_past_peak: 2,
-            pull_in: TrackerSettings::PULL_IN,
-            pull_in_timeout_s: 6e-3,
+            pull_in,
+            pull_in_timeout_s: 2.0 * pull_in_time_s(&pull_in, stack),
         }
     }
+}
+
+/// The coarse sweep's lag behind the resonance, bandwidths `f0 / Q`, that
+/// [`SearchConfig::new`] allows: the sweep's rate times the envelope time constant.
+///
+/// Swept at a rate `rho` (Hz/s) the envelope lags the drive by `tau` and the conductance's
+/// peak comes `rho tau` late (the quasi-static lag of a first-order envelope). The pull-in
+/// starts there, `2 x 2 = 4` half-bandwidths from f0: well inside the range the detuning reads
+/// ([`crate::resonance::MAX_DETUNING`], 16) and where the motional phase (76 degrees at `x = 4`) still
+/// grows with the error, so the loop's first correction has the right sign and size. A lag of
+/// one bandwidth per `tau / 2` of dwell: the sweep takes `Q tau / 2` per unit of relative
+/// band (2.4 ms a bandwidth at 20 kHz, Q 300; 0.4 ms at 40 kHz, Q 100). The docs
+/// (docs/resonance.md) give the diagnosis that led here: one 4-period window a bandwidth
+/// lags `Q / (4 pi)` bandwidths, 24 at Q 300, beyond what the detuning can read.
+pub const SWEEP_LAG_BANDWIDTHS: f64 = 2.0;
+
+/// The time the pull-in loop `pull_in` takes on `stack`'s resonator, s: from the sweep's lag
+/// ([`SWEEP_LAG_BANDWIDTHS`], `2 x 2` half-bandwidths) to `lock_detuning` at the loop's decay
+/// rate ([`TrackerSettings::decay_rate_per_s`]), then the hold of one envelope time
+/// constant ([`SearchConfig::new`]).
+pub fn pull_in_time_s(pull_in: &TrackerSettings, stack: &StackSettings) -> f64 {
+    let tau_s = stack.quality_factor / (core::f64::consts::PI * stack.resonance_hz);
+    let start = 2.0 * SWEEP_LAG_BANDWIDTHS;
+    let decay = libm::log(start / pull_in.lock_detuning).max(0.0) / pull_in.decay_rate_per_s(tau_s);
+    decay + tau_s
 }
 
 /// [`SearchSettings`] in fixed point.
@@ -92,6 +121,8 @@ pub struct SearchConfig {
     amplitude: Amplitude,
     pull_in: TrackerConfig,
     pull_in_timeout_samples: u64,
+    /// [`Self::lock_bound_s`] in microseconds.
+    lock_bound_us: u32,
 }
 
 impl SearchConfig {
@@ -121,10 +152,18 @@ impl SearchConfig {
         }
         let fraction = Q2_30::from_f64(s.amplitude).map_err(|_| ResonanceError::Setting)?;
         let amplitude = Amplitude::new(fraction)?;
-        // Overrun: the points swept during one envelope time constant at nominal f0.
-        let windows = f64::from(s.settle_windows) + f64::from(s.measure_windows);
-        let point_s = windows * f64::from(lock_in.periods_per_window) / stack.resonance_hz;
         let tau_s = stack.quality_factor / (core::f64::consts::PI * stack.resonance_hz);
+        let window_s = f64::from(lock_in.periods_per_window) / stack.resonance_hz;
+        // Dwell: the sweep's lag, `relative_step Q` bandwidths per point times `tau / point`,
+        // at most SWEEP_LAG_BANDWIDTHS; the extra windows settle.
+        let lag_dwell_s = s.relative_step * stack.quality_factor * tau_s / SWEEP_LAG_BANDWIDTHS;
+        let lag_windows = libm::ceil(lag_dwell_s / window_s - 1e-9).min(f64::from(u16::MAX));
+        let settle_windows = s
+            .settle_windows
+            .max((lag_windows as u16).saturating_sub(s.measure_windows));
+        // Overrun: the points swept during one envelope time constant at nominal f0.
+        let windows = f64::from(settle_windows) + f64::from(s.measure_windows);
+        let point_s = windows * window_s;
         let overrun = libm::ceil(tau_s / point_s);
         let growth = libm::log(1.0 + s.relative_step);
         let start = (s.min_hz / (1.0 + s.relative_step)).max(20_000.0);
@@ -139,7 +178,7 @@ impl SearchConfig {
             start_mhz: libm::round(start * 1000.0) as u32,
             relative_step_q32: libm::round(s.relative_step * 4_294_967_296.0) as u32,
             points: points as u16,
-            settle_windows: s.settle_windows,
+            settle_windows,
             measure_windows: s.measure_windows,
             stop_past_peak: s.stop_past_peak,
             start_up: overrun.min(f64::from(u16::MAX)) as u16,
@@ -147,7 +186,6 @@ impl SearchConfig {
         };
         // Lock must hold for one envelope time constant: a lagging motional phase can pass
         // through zero while the frequency is still overshooting.
-        let window_s = f64::from(lock_in.periods_per_window) / stack.resonance_hz;
         let hold = libm::ceil(tau_s / window_s).min(f64::from(u16::MAX)) as u16;
         let pull_in = TrackerSettings {
             min_hz: s.min_hz,
@@ -155,8 +193,14 @@ impl SearchConfig {
             lock_windows: s.pull_in.lock_windows.max(hold),
             ..s.pull_in
         };
+        // The rule's time: every point (the lowest frequency's windows are the longest),
+        // then the pull-in and its hold.
+        let sweep_s = points * windows * f64::from(lock_in.periods_per_window) / start;
+        let hold_s = f64::from(hold) * window_s;
+        let lock_bound_s = sweep_s + pull_in_time_s(&pull_in, stack) - tau_s + hold_s;
         let pull_in = TrackerConfig::new(&pull_in, model, lock_in.sample_rate_hz)?;
         Ok(Self {
+            lock_bound_us: libm::ceil(lock_bound_s * 1e6).min(f64::from(u32::MAX)) as u32,
             plan,
             overrun_cut,
             amplitude,
@@ -175,6 +219,15 @@ impl SearchConfig {
     /// The drive amplitude during the search.
     pub const fn amplitude(&self) -> Amplitude {
         self.amplitude
+    }
+
+    /// The time the search takes to lock by its own rule, s, whichever f0 in the band:
+    /// every point of the sweep at its dwell (f0 at the band's top; f0 lower ends the sweep
+    /// sooner), then the pull-in from the sweep's lag to the lock band at the loop's decay
+    /// rate and the hold of one envelope time constant ([`pull_in_time_s`]). A scene's
+    /// target must not ask for vibration before it (`crate::scene::feasibility`).
+    pub fn lock_bound_s(&self) -> f64 {
+        f64::from(self.lock_bound_us) * 1e-6
     }
 }
 

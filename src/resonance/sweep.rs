@@ -112,7 +112,19 @@ pub struct Sweep {
     best_index: u16,
     before_best: SweepPoint,
     after_best: Option<SweepPoint>,
+    /// Sum of the squared in-phase components (Q2.30 bits squared) of every window of the
+    /// start-up points, and their count: the noise floor a peak must stand out of.
+    floor_sum_squares: u128,
+    floor_windows: u32,
 }
+
+/// How many standard deviations of the start-up points' in-phase current a peak that ends
+/// the sweep early stands above them: 4 (a Gaussian noise point passes it with probability
+/// 3e-5). The current sense's noise is the sweep's own measurement, not a setting: at Q 300
+/// the conductance off resonance is below one converter step, and a single noisy window
+/// above [`SweepPlan::min_peak`] followed by one below half of it ended the sweep
+/// before f0 (docs/resonance.md).
+pub const PEAK_NOISE_RATIO: u32 = 4;
 
 impl Sweep {
     /// A sweep at its first point. Error: the timer cannot make the first point's frequency
@@ -133,6 +145,8 @@ impl Sweep {
             best_index: 0,
             before_best: SweepPoint::default(),
             after_best: None,
+            floor_sum_squares: 0,
+            floor_windows: 0,
         })
     }
 
@@ -151,6 +165,12 @@ impl Sweep {
     /// telemetry). Integer only; one division per point.
     pub fn update(&mut self, window: &Demodulated) -> (Option<SweepPoint>, SweepProgress) {
         self.windows = self.windows.saturating_add(1);
+        if self.index < self.plan.start_up {
+            let in_phase = i128::from(window.phasor.in_phase.to_bits());
+            // < 2^62 per window, < 2^32 windows: fits u128.
+            self.floor_sum_squares += (in_phase * in_phase) as u128;
+            self.floor_windows = self.floor_windows.saturating_add(1);
+        }
         if self.windows > self.plan.settle_windows {
             // |in-phase| < 2^31 and samples < 2^21 per window: 2^16 windows fit i64.
             self.weighted_sum +=
@@ -180,6 +200,7 @@ impl Sweep {
             && self.best_index > 0
             && self.best_index >= self.plan.start_up
             && self.best.conductance >= self.plan.min_peak
+            && self.above_floor(self.best.conductance)
             && past >= self.plan.stop_past_peak
             && i64::from(point.conductance.to_bits()) * 2
                 <= i64::from(self.best.conductance.to_bits());
@@ -195,6 +216,20 @@ impl Sweep {
             // The last point, or the next one is beyond what the timer can make.
             _ => (Some(point), SweepProgress::Done(self.result())),
         }
+    }
+
+    /// `conductance` stands [`PEAK_NOISE_RATIO`] standard deviations of a point's mean above
+    /// the start-up windows' RMS in-phase current: `G^2 n m >= 16 sum x^2` over `n` start-up
+    /// windows, a point averaging `m` windows. Integer; false before any start-up window.
+    fn above_floor(&self, conductance: Q2_30) -> bool {
+        if self.floor_windows == 0 {
+            return false;
+        }
+        let g = i128::from(conductance.to_bits().max(0)) as u128;
+        let ratio = u128::from(PEAK_NOISE_RATIO * PEAK_NOISE_RATIO);
+        // g^2 < 2^62, windows < 2^32, measure < 2^16: < 2^110.
+        g * g * u128::from(self.floor_windows) * u128::from(self.plan.measure_windows.max(1))
+            >= ratio * self.floor_sum_squares
     }
 
     fn record(&mut self, point: SweepPoint) {

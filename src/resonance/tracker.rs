@@ -86,7 +86,47 @@ impl TrackerSettings {
         no_current_windows: 20,
         ..Self::OPERATION
     };
+
+    /// These settings with the integral gain and the rate bound derived from the resonator's
+    /// envelope (f0 `resonance_hz`, `quality_factor`; both in range for [`StackModel`]), the
+    /// proportional gain kept.
+    ///
+    /// The motional phase, hence the measured error `e`, follows the drive frequency through
+    /// the envelope's lag `1 / (1 + s tau)`, `tau = Q / (pi f0)` (physics-notes section 7).
+    /// The velocity-form PI, `df/dt = -Kp de/dt - Ki e`, closes the loop
+    /// `tau s^2 + (1 + Kp) s + Ki = 0`: the error decays at `(1 + Kp) / (2 tau)` and the
+    /// damping ratio is `(1 + Kp) / (2 sqrt(tau Ki))`. [`LOOP_DAMPING`] gives
+    /// `Ki = (1 + Kp)^2 / (4 zeta^2 tau)`: 1,410 /s at 40 kHz, Q 100; 235 /s at 20 kHz,
+    /// Q 300; 7,070 /s at 60 kHz, Q 30. A fixed `Ki` (3,000 /s before) is a damping ratio of
+    /// 0.48 at 40 kHz, Q 100 but 0.20 at 20 kHz, Q 300: the loop rings for many `tau` and
+    /// its detuning never stays within the lock band for the hold (docs/resonance.md).
+    ///
+    /// The rate bound lets the loop cross the whole range the detuning reads,
+    /// [`MAX_DETUNING`] half-bandwidths, in one `tau`: `R = 16 (f0 / 2Q) / tau = 8 pi f0^2 /
+    /// Q^2` (4.0 MHz/s at 40 kHz, Q 100; 112 kHz/s at 20 kHz, Q 300). Faster than that
+    /// the envelope cannot follow and the measured detuning is a transient's.
+    pub fn on_resonator(self, resonance_hz: f64, quality_factor: f64) -> Self {
+        let tau_s = quality_factor / (core::f64::consts::PI * resonance_hz);
+        let half_bandwidth_hz = resonance_hz / (2.0 * quality_factor);
+        let kp = self.proportional;
+        Self {
+            integral_per_s: (1.0 + kp) * (1.0 + kp) / (4.0 * LOOP_DAMPING * LOOP_DAMPING * tau_s),
+            max_rate_hz_per_s: MAX_DETUNING.to_f64() * half_bandwidth_hz / tau_s,
+            ..self
+        }
+    }
+
+    /// The rate, 1/s, at which the loop of [`Self::on_resonator`] shrinks an error on a
+    /// resonator of envelope time constant `tau_s`: `(1 + Kp) / (2 tau)`.
+    pub fn decay_rate_per_s(&self, tau_s: f64) -> f64 {
+        (1.0 + self.proportional) / (2.0 * tau_s)
+    }
 }
+
+/// The damping ratio [`TrackerSettings::on_resonator`] designs for, `1 / sqrt 2` (overshoot
+/// 4.3 %): every ratio below 1 decays at the same `(1 + Kp) / (2 tau)`, a smaller one
+/// overshoots more, and one above 1 splits the poles, the slower decaying slower.
+pub const LOOP_DAMPING: f64 = core::f64::consts::FRAC_1_SQRT_2;
 
 /// [`TrackerSettings`] in fixed point, with the stack model it works on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

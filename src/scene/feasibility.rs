@@ -108,6 +108,15 @@ pub enum Cause {
     },
     /// The controller's model could not be evaluated at the scene's operating points.
     Model(ModelError),
+    /// `freq auto`: the resonance search may lock after the scene's first judged instant.
+    SearchOutlastsStart {
+        /// The stack's declared quality factor.
+        quality_factor: f64,
+        /// The search's time to lock by its rule, s.
+        lock_bound_s: f64,
+        /// The first target change after t = 0 or criterion window, s.
+        first_step_s: f64,
+    },
 }
 
 /// One thing that cannot, or may not, work, with the scene key it comes from.
@@ -131,6 +140,7 @@ impl Finding {
             Cause::NoSliding { .. } => "the speed is below the sliding threshold",
             Cause::Noise { .. } => "the cells' noise exceeds the accuracy band",
             Cause::Model(_) => "the controller's model fails over the scene",
+            Cause::SearchOutlastsStart { .. } => "the resonance search may outlast the first step",
         }
     }
 }
@@ -202,12 +212,26 @@ impl fmt::Display for Finding {
                 "{}: the controller's model cannot be evaluated over the scene: {error}",
                 self.field
             ),
+            Cause::SearchOutlastsStart {
+                quality_factor,
+                lock_bound_s,
+                first_step_s,
+            } => write!(
+                f,
+                "{} = true: the resonance search (f0 +- 10 %, Q {}) locks by its rule within \
+                 {:.2} ms, f0 at the band's top (docs/resonance.md); the scene judges the loop \
+                 from {:.2} ms, and the friction loop starts only at the lock",
+                self.field,
+                quality_factor,
+                lock_bound_s * 1e3,
+                first_step_s * 1e3
+            ),
         }
     }
 }
 
 /// Most findings [`check`] returns: one per check.
-pub const MAX_FINDINGS: usize = 4;
+pub const MAX_FINDINGS: usize = 5;
 
 /// The findings of [`check`], worst of each check.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -251,7 +275,50 @@ pub fn check<M: FrictionModel + ?Sized>(scene: &Scene<'_>, model: &M) -> Feasibi
     result.push(sliding(scene, &settings));
     result.push(reach(scene, &settings, model));
     result.push(noise(scene, &settings));
+    result.push(search_timing(scene));
     result
+}
+
+/// `freq auto`: the resonance search's time by its rule
+/// ([`crate::resonance::ResonanceSettings::search_lock_bound_s`], f0 anywhere in its band)
+/// against the scene's first judged instant (the first target change after t = 0 or the
+/// start of the first criterion window). The friction loop starts at the lock, so a step
+/// before it is judged on a loop that is not running yet: a warning (f0 low in the band locks
+/// sooner), with both times. `None` without `freq auto`, for a commissioned scene (it starts
+/// at the measured f0) or a stack the resonance loop refuses (the station reports that).
+pub fn search_timing(scene: &Scene<'_>) -> Option<Finding> {
+    if !scene.transducer.shift.freq_auto || scene.commission {
+        return None;
+    }
+    let settings = crate::resonance::ResonanceSettings::around(&crate::station::scene_stack(scene));
+    let lock_bound_s = settings.search_lock_bound_s().ok()?;
+    let first_step_s = first_judged_s(scene);
+    (first_step_s < lock_bound_s).then_some(Finding {
+        severity: Severity::Warn,
+        field: "transducer.shift.freq_auto",
+        cause: Cause::SearchOutlastsStart {
+            quality_factor: scene.transducer.quality_factor,
+            lock_bound_s,
+            first_step_s,
+        },
+    })
+}
+
+/// The scene's first judged instant, s: its first target change after t = 0 or the start of
+/// its first criterion window (the duration when it has neither).
+pub fn first_judged_s(scene: &Scene<'_>) -> f64 {
+    scene
+        .target
+        .iter()
+        .skip(1)
+        .map(|point| point.at_s)
+        .chain(scene.criteria.iter().filter_map(|c| match *c {
+            Criterion::SteadyRmsError { from_s, .. } | Criterion::TrackingError { from_s, .. } => {
+                Some(from_s)
+            }
+            _ => None,
+        }))
+        .fold(scene.duration_s, f64::min)
 }
 
 /// The transducer's vibration gain at the drive frequency, at time `t_s` (1 on resonance).

@@ -18,7 +18,7 @@
 use std::path::Path;
 use std::process::ExitCode;
 
-use sonolube::scene::{Criterion, SCENES, Scene};
+use sonolube::scene::{Breakpoint, Criterion, FaultEvent, SCENES, Scene, TargetPoint};
 use sonolube_sim::RunSummary;
 
 pub use super::grid::GridDrive;
@@ -84,6 +84,7 @@ pub fn run(
     let mut passed_scenes = 0;
     let mut total_runs = 0;
     let mut failed_runs = 0;
+    let mut infeasible_runs = 0;
     let mut all = Vec::new();
     for scene in scenes {
         let own = [scene.noise_seed];
@@ -113,9 +114,10 @@ pub fn run(
         match result {
             Ok(done) => {
                 total_runs += done.results.len();
+                infeasible_runs += done.infeasible;
                 let failed = done.results.iter().filter(|r| !is_pass(r)).count();
                 failed_runs += failed;
-                if failed == 0 {
+                if failed == 0 && done.infeasible == 0 {
                     passed_scenes += 1;
                 }
                 all.push((scene.name.to_string(), done));
@@ -136,15 +138,20 @@ pub fn run(
             }
         }
     }
+    let infeasible = if infeasible_runs > 0 {
+        format!("; {infeasible_runs} more infeasible, refused before running (reasons above)")
+    } else {
+        String::new()
+    };
     println!(
-        "{} of {} scenes passed every run; {} of {} runs failed ({}, {jobs} threads)",
+        "{} of {} scenes passed every run; {} of {} runs failed{infeasible} ({}, {jobs} threads)",
         passed_scenes,
         scenes.len(),
         failed_runs,
         total_runs,
         seeds.map_or(String::from("own seeds"), seeds_text)
     );
-    if failed_runs == 0 {
+    if failed_runs == 0 && infeasible_runs == 0 {
         ExitCode::SUCCESS
     } else {
         ExitCode::FAILURE
@@ -161,6 +168,9 @@ pub struct Done {
     pub stats: Vec<super::sweep::CriterionStats>,
     /// Per run.
     pub results: Vec<Result<RunSummary, String>>,
+    /// Runs refused before running because they cannot work (with the reason printed), not
+    /// counted in `results`.
+    pub infeasible: usize,
 }
 
 /// Runs `runs` of `scene` and prints their table and failures.
@@ -178,7 +188,11 @@ fn sweep_runs(scene: &Scene<'_>, runs: &[Run<'_>], jobs: usize) -> Result<Done, 
         results.iter().filter(|r| is_pass(r)).count(),
         results.len()
     );
-    Ok(Done { stats, results })
+    Ok(Done {
+        stats,
+        results,
+        infeasible: 0,
+    })
 }
 
 /// The noise sweep: the scene with both cells' noise at each level of [`NOISE_LEVELS_PCT`],
@@ -238,7 +252,11 @@ fn noise_sweep(scene: &Scene<'_>, seeds: &[u64], jobs: usize) -> Result<Done, St
         "  (growth: RMS error ratio over noise ratio from the level above; <= 1 grows no faster than the noise)"
     );
     let stats = criterion_stats(scene, &runs, &results);
-    Ok(Done { stats, results })
+    Ok(Done {
+        stats,
+        results,
+        infeasible: 0,
+    })
 }
 
 /// Resonance frequencies of the resonator sweep, Hz (the stack's 20-60 kHz range, seed 003
@@ -263,7 +281,13 @@ pub const RESONATOR_Q: [f64; 5] = [30.0, 60.0, 100.0, 200.0, 300.0];
 /// - the drive runs `freq auto` (search, then track) on the complex envelope, from the
 ///   nominal f0;
 /// - the settle limit is max(the scene's, 2 tau), tau = 2 Q / w0 = Q / (pi f0), the envelope
-///   time constant (physics-notes §7).
+///   time constant (physics-notes §7);
+/// - the scene's timeline (its profiles' and targets' points after t = 0, its fault events and
+///   its criteria windows, and its duration) moves later by the time the search's rule
+///   allows it to lock ([`sonolube::resonance::ResonanceSettings::search_lock_bound_s`]):
+///   the friction loop starts at the lock, so the scene's own start-up before its first
+///   step (the loop's ramp) comes after it, and a search on a slow envelope takes longer
+///   (105 ms at 20 kHz, Q 300: docs/resonance.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Resonator {
     /// Resonance f0, Hz.
@@ -284,6 +308,21 @@ pub struct Resonator {
     pub time_constant_s: f64,
     /// The settle limit, s.
     pub settle_s: f64,
+    /// The search's time to lock by its rule, s (f0 anywhere in its +-10 % band).
+    pub search_lock_s: f64,
+    /// How much later the scene's timeline runs, s: the search's time, in whole control
+    /// periods.
+    pub lead_s: f64,
+}
+
+/// What [`Resonator::adapt`] changes in a scene, owned for the run's borrowed `Scene`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Adapted {
+    criteria: Vec<Criterion>,
+    normal_load_n: Vec<Breakpoint>,
+    sliding_velocity_m_per_s: Vec<Breakpoint>,
+    target: Vec<TargetPoint>,
+    faults: Vec<FaultEvent>,
 }
 
 impl Resonator {
@@ -318,7 +357,25 @@ impl Resonator {
                 "the scene's transducer and actuator give no resonator at {resonance_hz} Hz, Q {quality_factor}"
             ));
         }
+        let mut on_resonator = *scene;
+        on_resonator.transducer.resonance_hz = resonance_hz;
+        on_resonator.transducer.quality_factor = quality_factor;
+        on_resonator.actuator.full_scale_voltage_v = voltage;
+        let stack = sonolube::station::scene_stack(&on_resonator);
+        let search_lock_s = sonolube::resonance::ResonanceSettings::around(&stack)
+            .search_lock_bound_s()
+            .map_err(|e| {
+                format!("no resonance search at {resonance_hz} Hz, Q {quality_factor}: {e:?}")
+            })?;
+        // The friction loop starts at the lock: the scene's own start (its t = 0, where a
+        // pinned run starts its loop and ramps up before the first step) moves there. Whole
+        // control periods, so that the moved events fall on the same phase of the control
+        // step as the scene's.
+        let period_s = 1.0 / scene.control_rate_hz;
+        let lead_s = (search_lock_s / period_s).ceil() * period_s;
         Ok(Self {
+            search_lock_s,
+            lead_s,
             resonance_hz,
             quality_factor,
             motional_resistance_ohm: r1,
@@ -331,10 +388,10 @@ impl Resonator {
         })
     }
 
-    /// `scene` on this resonator, its criteria replaced by `criteria` (the scene's with the
-    /// settle limit widened: [`Self::criteria`]).
-    pub fn apply<'a>(&self, scene: &Scene<'a>, criteria: &'a [Criterion]) -> Scene<'a> {
-        let mut s = *scene;
+    /// `scene` on this resonator, its criteria and timeline replaced by `adapted`
+    /// ([`Self::adapt`]).
+    pub fn apply<'a>(&self, scene: &Scene<'a>, adapted: &'a Adapted) -> Scene<'a> {
+        let mut s = adapted.apply(scene, self.lead_s);
         s.transducer.resonance_hz = self.resonance_hz;
         s.transducer.drive_hz = self.resonance_hz;
         s.transducer.quality_factor = self.quality_factor;
@@ -343,23 +400,46 @@ impl Resonator {
         s.transducer.shift.freq_auto = true;
         s.actuator.full_scale_voltage_v = self.full_scale_voltage_v;
         s.actuator.full_scale_amplitude_m = self.full_scale_amplitude_m;
-        s.criteria = criteria;
         s
     }
 
-    /// The scene's criteria with the settle limit at [`Self::settle_s`].
-    pub fn criteria(&self, scene: &Scene<'_>) -> Vec<Criterion> {
-        scene
-            .criteria
+    /// The scene's criteria with the settle limit at [`Self::settle_s`], and its timeline
+    /// from its first event on later by [`Self::lead_s`].
+    pub fn adapt(&self, scene: &Scene<'_>) -> Adapted {
+        shifted(scene, self.lead_s, Some(self.settle_s))
+    }
+
+    /// Why this resonator cannot do what `scene` asks within the stack's ratings, if so:
+    /// the largest reduction a target asks for against the largest the plant's steady state
+    /// gives at full scale ([`reachable_reduction_pct`]; the voltage there is the largest
+    /// V_max and I_max allow, C0's current included).
+    pub fn infeasible(&self, scene: &Scene<'_>) -> Option<String> {
+        let asked = scene
+            .target
             .iter()
-            .map(|c| match *c {
-                Criterion::Settle { band_pct, .. } => Criterion::Settle {
-                    band_pct,
-                    within_s: self.settle_s,
-                },
-                other => other,
+            .filter_map(|p| match p.target {
+                sonolube::protocol::Target::Reduction { reduction_mpct } => {
+                    Some(f64::from(reduction_mpct) * 1e-3)
+                }
+                _ => None,
             })
-            .collect()
+            .fold(0.0, f64::max);
+        let reach = reachable_reduction_pct(scene);
+        (reach < asked).then(|| {
+            format!(
+                "{}: infeasible within the stack's ratings: the target asks {asked:.1} % \
+                 reduction; at full scale ({:.2} V, {:.3} A of I_max {} A, C0's {:.3} A at \
+                 that voltage included) the plant reaches {reach:.1} %",
+                self.label(),
+                self.full_scale_voltage_v,
+                self.full_scale_current_a,
+                scene.actuator.max_current_a,
+                std::f64::consts::TAU
+                    * self.resonance_hz
+                    * scene.transducer.clamped_capacitance_f
+                    * self.full_scale_voltage_v,
+            )
+        })
     }
 
     fn label(&self) -> String {
@@ -371,6 +451,101 @@ impl Resonator {
     }
 }
 
+impl Adapted {
+    /// `scene` with these criteria and this timeline, its duration `lead_s` longer (the lead
+    /// [`shifted`] was given).
+    pub fn apply<'a>(&'a self, scene: &Scene<'a>, lead_s: f64) -> Scene<'a> {
+        Scene {
+            duration_s: scene.duration_s + lead_s,
+            normal_load_n: &self.normal_load_n,
+            sliding_velocity_m_per_s: &self.sliding_velocity_m_per_s,
+            target: &self.target,
+            faults: &self.faults,
+            criteria: &self.criteria,
+            ..*scene
+        }
+    }
+}
+
+/// `scene`'s criteria and timeline for a `freq auto` run whose friction loop starts at the
+/// search's lock: every point after t = 0 of its profiles, targets and faults, and its
+/// criteria windows, later by `lead` s; the settle limit replaced by `settle_s` if given.
+/// [`search_lead_s`] gives the lead the search's rule needs (other sweeps that run `freq auto`
+/// on a scene written for a pinned drive can use both).
+pub fn shifted(scene: &Scene<'_>, lead: f64, settle_s: Option<f64>) -> Adapted {
+    let later = |t: f64| if t > 0.0 { t + lead } else { t };
+    let breakpoints = |points: &[Breakpoint]| -> Vec<Breakpoint> {
+        points
+            .iter()
+            .map(|p| Breakpoint {
+                t_s: later(p.t_s),
+                ..*p
+            })
+            .collect()
+    };
+    Adapted {
+        criteria: scene
+            .criteria
+            .iter()
+            .map(|c| match *c {
+                Criterion::Settle { band_pct, within_s } => Criterion::Settle {
+                    band_pct,
+                    within_s: settle_s.unwrap_or(within_s),
+                },
+                Criterion::SteadyRmsError {
+                    max_pct,
+                    from_s,
+                    to_s,
+                } => Criterion::SteadyRmsError {
+                    max_pct,
+                    from_s: from_s + lead,
+                    to_s: to_s + lead,
+                },
+                Criterion::TrackingError {
+                    max_pct,
+                    from_s,
+                    to_s,
+                } => Criterion::TrackingError {
+                    max_pct,
+                    from_s: from_s + lead,
+                    to_s: to_s + lead,
+                },
+                other => other,
+            })
+            .collect(),
+        normal_load_n: breakpoints(scene.normal_load_n),
+        sliding_velocity_m_per_s: breakpoints(scene.sliding_velocity_m_per_s),
+        target: scene
+            .target
+            .iter()
+            .map(|p| TargetPoint {
+                at_s: later(p.at_s),
+                ..*p
+            })
+            .collect(),
+        faults: scene
+            .faults
+            .iter()
+            .map(|f| FaultEvent {
+                at_s: later(f.at_s),
+                ..*f
+            })
+            .collect(),
+    }
+}
+
+/// The time `freq auto`'s search needs on `scene`'s declared stack by its rule
+/// ([`sonolube::resonance::ResonanceSettings::search_lock_bound_s`]), in whole control
+/// periods: the lead [`shifted`] gives a scene so that its own start comes after the lock.
+pub fn search_lead_s(scene: &Scene<'_>) -> Result<f64, String> {
+    let stack = sonolube::station::scene_stack(scene);
+    let lock_s = sonolube::resonance::ResonanceSettings::around(&stack)
+        .search_lock_bound_s()
+        .map_err(|e| format!("no resonance search on the scene's stack: {e:?}"))?;
+    let period_s = 1.0 / scene.control_rate_hz;
+    Ok((lock_s / period_s).ceil() * period_s)
+}
+
 /// The resonator sweep: the scene on every (f0, Q) of [`RESONATOR_F0_HZ`] x [`RESONATOR_Q`]
 /// ([`Resonator`]), on every seed; a table of the resonators and their verdicts.
 fn resonator_sweep(scene: &Scene<'_>, seeds: &[u64], jobs: usize) -> Result<Done, String> {
@@ -380,10 +555,17 @@ fn resonator_sweep(scene: &Scene<'_>, seeds: &[u64], jobs: usize) -> Result<Done
             resonators.push(Resonator::of(scene, f0, q)?);
         }
     }
-    let criteria: Vec<Vec<Criterion>> = resonators.iter().map(|r| r.criteria(scene)).collect();
+    let adapted: Vec<Adapted> = resonators.iter().map(|r| r.adapt(scene)).collect();
     let mut runs = Vec::new();
-    for (resonator, criteria) in resonators.iter().zip(&criteria) {
-        let changed = resonator.apply(scene, criteria);
+    // Per resonator: its first run's index, or why it cannot work (no runs).
+    let mut first_run: Vec<Result<usize, String>> = Vec::new();
+    for (resonator, adapted) in resonators.iter().zip(&adapted) {
+        let changed = resonator.apply(scene, adapted);
+        if let Some(reason) = resonator.infeasible(&changed) {
+            first_run.push(Err(reason));
+            continue;
+        }
+        first_run.push(Ok(runs.len()));
         for &seed in seeds {
             runs.push(Run {
                 label: if seeds.len() > 1 {
@@ -399,21 +581,25 @@ fn resonator_sweep(scene: &Scene<'_>, seeds: &[u64], jobs: usize) -> Result<Done
             });
         }
     }
+    let infeasible: Vec<&String> = first_run.iter().filter_map(|r| r.as_ref().err()).collect();
     println!(
         "{}: resonators f0 {:?} kHz x Q {:?}, drive freq auto (search, then track), full scale \
-         within V_max {} V and I_max {} A, settle limit max(the scene's, 2 tau), {} runs, {}",
+         within V_max {} V and I_max {} A, settle limit max(the scene's, 2 tau), the scene's \
+         timeline later when the search's rule needs it, {} runs ({} resonators infeasible, \
+         not run), {}",
         scene.name,
         RESONATOR_F0_HZ.map(|f| f / 1e3),
         RESONATOR_Q,
         scene.actuator.max_voltage_v,
         scene.actuator.max_current_a,
         runs.len(),
+        infeasible.len(),
         seeds_text(seeds)
     );
     let results = run_all(&runs, jobs, "resonators");
     println!(
-        "  {:>6} {:>4} {:>8} {:>7} {:>7} {:>7} {:>8} {:>8} {:>8} {:>9} {:>9} {:>6}  measured \
-         (worst seed)",
+        "  {:>6} {:>4} {:>8} {:>7} {:>7} {:>7} {:>8} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>6}  \
+         measured (worst seed)",
         "f0 kHz",
         "Q",
         "tau ms",
@@ -423,21 +609,26 @@ fn resonator_sweep(scene: &Scene<'_>, seeds: &[u64], jobs: usize) -> Result<Done
         "Ic@Vmax",
         "x_a um",
         "reach %",
+        "search ms",
+        "later ms",
         "settle ms",
         "limit ms",
         "pass",
     );
-    for (k, resonator) in resonators.iter().enumerate() {
-        let chunk = &results[k * seeds.len()..(k + 1) * seeds.len()];
+    for ((resonator, first), adapted) in resonators.iter().zip(&first_run).zip(&adapted) {
+        let reach = reachable_reduction_pct(&resonator.apply(scene, adapted));
+        let chunk = match first {
+            Ok(k) => &results[*k..*k + seeds.len()],
+            Err(_) => &results[0..0],
+        };
         let passed = chunk.iter().filter(|r| is_pass(r)).count();
         let worst = chunk.iter().find(|r| !is_pass(r)).or(chunk.first());
         let at_limit_ms = worst
             .and_then(|r| r.as_ref().ok())
             .map_or(f64::NAN, |s| f64::from(s.time_at_limit_s) * 1e3);
-        let reach = reachable_reduction_pct(&runs[k * seeds.len()].scene);
-        let measured = chunk.iter().find(|r| !is_pass(r)).or(chunk.first()).map_or(
-            String::new(),
-            |r| match r {
+        let measured = match first {
+            Err(_) => String::from("infeasible (below)"),
+            Ok(_) => worst.map_or(String::new(), |r| match r {
                 Ok(summary) => summary
                     .verdicts
                     .iter()
@@ -451,11 +642,15 @@ fn resonator_sweep(scene: &Scene<'_>, seeds: &[u64], jobs: usize) -> Result<Done
                     .collect::<Vec<_>>()
                     .join(", "),
                 Err(error) => error.clone(),
-            },
-        );
+            }),
+        };
+        let pass = match first {
+            Ok(_) => format!("{passed}/{}", chunk.len()),
+            Err(_) => String::from("infeas"),
+        };
         println!(
-            "  {:>6.0} {:>4.0} {:>8.3} {:>7.3} {:>7.2} {:>7.3} {:>8.3} {:>8.3} {:>8.1} {:>9.2} {:>9.1} \
-             {:>6}  {}",
+            "  {:>6.0} {:>4.0} {:>8.3} {:>7.3} {:>7.2} {:>7.3} {:>8.3} {:>8.3} {:>8.1} {:>9.2} {:>9.2} \
+             {:>9.2} {:>9.1} {:>6}  {}",
             resonator.resonance_hz / 1e3,
             resonator.quality_factor,
             resonator.time_constant_s * 1e3,
@@ -465,15 +660,19 @@ fn resonator_sweep(scene: &Scene<'_>, seeds: &[u64], jobs: usize) -> Result<Done
             resonator.capacitive_current_at_max_v_a,
             resonator.full_scale_amplitude_m * 1e6,
             reach,
+            resonator.search_lock_s * 1e3,
+            resonator.lead_s * 1e3,
             resonator.settle_s * 1e3,
             at_limit_ms,
-            format!("{passed}/{}", chunk.len()),
+            pass,
             measured
         );
     }
     println!(
         "  (reach: the largest reduction the plant's steady state gives at full scale at the \
-         scene's first load and speed; limit: time with the drive at its ceiling)"
+         scene's first load and speed; search: the time the resonance search's rule allows it \
+         to lock, f0 anywhere in +-10 %; later: how much later the scene's timeline runs, the \
+         friction loop starting at the lock; limit: time with the drive at its ceiling)"
     );
     let stats = criterion_stats(scene, &runs, &results);
     print!("{}", stats_table(&stats));
@@ -481,7 +680,14 @@ fn resonator_sweep(scene: &Scene<'_>, seeds: &[u64], jobs: usize) -> Result<Done
     for line in failures(&runs, &results) {
         println!("  FAIL {line}");
     }
-    Ok(Done { stats, results })
+    for reason in &infeasible {
+        println!("  INFEASIBLE {reason}");
+    }
+    Ok(Done {
+        stats,
+        results,
+        infeasible: infeasible.len() * seeds.len(),
+    })
 }
 
 /// The largest friction reduction, %, the plant's steady-state model gives at full amplitude
@@ -590,7 +796,11 @@ fn envelope(scene: &Scene<'_>, seeds: &[u64], jobs: usize, out: &Path) -> Result
              {CELL_MARGIN} x the plant's natural friction, noise still in % FS)"
         ),
     );
-    Ok(Done { stats, results })
+    Ok(Done {
+        stats,
+        results,
+        infeasible: 0,
+    })
 }
 
 /// Below 1 N the cells' noise, not the physics, limits the steady error: for each such load
@@ -765,8 +975,12 @@ mod tests {
                 assert!(
                     (r.settle_s - (2.0 * q / (std::f64::consts::PI * f0)).max(3e-3)).abs() < 1e-15
                 );
-                let criteria = r.criteria(scene);
-                let run = r.apply(scene, &criteria);
+                let adapted = r.adapt(scene);
+                let run = r.apply(scene, &adapted);
+                // The scene's start-up comes after the search's rule allows it to lock.
+                assert!(r.lead_s >= r.search_lock_s && r.lead_s < r.search_lock_s + 1e-4);
+                assert!((run.target[1].at_s - scene.target[1].at_s - r.lead_s).abs() < 1e-12);
+                assert!((run.duration_s - scene.duration_s - r.lead_s).abs() < 1e-12);
                 assert!(run.transducer.shift.freq_auto && run.transducer.shift.bvd_envelope);
                 assert_eq!(run.transducer.drive_hz, f0);
                 assert_eq!(run.plant, scene.plant);
