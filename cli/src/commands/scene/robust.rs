@@ -95,18 +95,7 @@ pub fn run(
                 println!("{}: {} runs, {}", scene.name, runs.len(), seeds_text(seeds));
                 sweep_runs(scene, &runs, jobs)
             }
-            Sweep::Mismatch(drive) => {
-                let runs = mismatch_runs(scene, seeds, drive);
-                println!(
-                    "{}: mismatch grid (plant mu x0.7/1/1.3, k_t x0.5/1/2, cell gain -2/0/+2 %, \
-                     resonance -0.5/0/+0.5 % of f0), {}, {} runs, {}",
-                    scene.name,
-                    drive.text(),
-                    runs.len(),
-                    seeds_text(seeds)
-                );
-                sweep_runs(scene, &runs, jobs)
-            }
+            Sweep::Mismatch(drive) => mismatch_sweep(scene, seeds, drive, jobs),
             Sweep::Noise => noise_sweep(scene, seeds, jobs),
             Sweep::Resonators => resonator_sweep(scene, seeds, jobs),
             Sweep::Envelope => envelope(scene, seeds, jobs, out),
@@ -544,6 +533,36 @@ pub fn search_lead_s(scene: &Scene<'_>) -> Result<f64, String> {
         .map_err(|e| format!("no resonance search on the scene's stack: {e:?}"))?;
     let period_s = 1.0 / scene.control_rate_hz;
     Ok((lock_s / period_s).ceil() * period_s)
+}
+
+/// The mismatch grid on `scene` driven as `drive` says ([`mismatch_runs`]).
+fn mismatch_sweep(
+    scene: &Scene<'_>,
+    seeds: &[u64],
+    drive: GridDrive,
+    jobs: usize,
+) -> Result<Done, String> {
+    // Under `freq auto` the grid judges the friction loop from the search's lock
+    // on: the scene's timeline starts the lead the search's rule needs later (a
+    // scene written for a pinned drive), as the resonator sweep does.
+    let lead = match drive {
+        GridDrive::FreqAuto => search_lead_s(scene)?,
+        GridDrive::Pinned => 0.0,
+    };
+    let adapted = shifted(scene, lead, None);
+    let base = adapted.apply(scene, lead);
+    let runs = mismatch_runs(&base, seeds, drive);
+    println!(
+        "{}: mismatch grid (plant mu x0.7/1/1.3, k_t x0.5/1/2, cell gain -2/0/+2 %, \
+         resonance -0.5/0/+0.5 % of f0), {}, {} runs, {}, timeline {:.1} ms later \
+         (the search's lock)",
+        scene.name,
+        drive.text(),
+        runs.len(),
+        seeds_text(seeds),
+        lead * 1e3
+    );
+    sweep_runs(&base, &runs, jobs)
 }
 
 /// The resonator sweep: the scene on every (f0, Q) of [`RESONATOR_F0_HZ`] x [`RESONATOR_Q`]
