@@ -66,6 +66,11 @@ pub enum HoldStep {
 pub struct NetForceHold {
     target: NetForceTarget,
     pi: Pi,
+    /// The amplitude commanded last period (Q1.31 bits), where this period's step starts.
+    commanded: i32,
+    /// Last period's evaluation (amplitude bits, drive ratio towards the centre in Q.30 bits):
+    /// with this period's it gives the secant slope of the Newton step ([`Self::step`]).
+    previous: Option<(i32, i64)>,
 }
 
 impl NetForceHold {
@@ -74,6 +79,8 @@ impl NetForceHold {
         Self {
             target,
             pi: Pi::new(),
+            commanded: 0,
+            previous: None,
         }
     }
 
@@ -96,6 +103,8 @@ impl NetForceHold {
     ) -> Result<HoldStep, ModelError> {
         if region == HornRegion::Transition {
             self.pi.reset();
+            self.commanded = 0;
+            self.previous = None;
             return Ok(HoldStep::Transition);
         }
         // mu F_n in Q16.16 (< 2 x 32768 N: i64).
@@ -117,27 +126,73 @@ impl NetForceHold {
         let candidate = self.pi.candidate(gains, Q2_30::from_bits(error_q30 as i32));
         // The centre direction decides which way a rising correction moves the drive.
         let centre_positive = point.shape.sin_shape.to_bits() <= 0;
-        let invert = |correction: Q2_30| -> Result<_, ModelError> {
-            let command = target_q16 + ((correction.to_bits() as i64 * coulomb) >> 30);
-            let command = command.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
-            model.amplitude_for_force(point, Q16_16::from_bits(command))
+        let s: i64 = if centre_positive { 1 } else { -1 };
+        // One Newton step per period from the last amplitude instead of a whole inversion
+        // (`MotorScene::amplitude_for_force`, about 18 to 50 evaluations): the block moves
+        // 0.8 um and the load barely changes in a period, so the root moves little, and the
+        // loop's next step corrects what one step leaves. One evaluation of the model, two when
+        // the secant is unusable (first step, no movement, or the falling stretch of a block
+        // moving away from the centre, which is then left by stepping up).
+        let here = self.commanded;
+        // In the drive ratio phi = F_t / (mu F_n) (Q2.30), which the measured load's noise does
+        // not move between two periods: the secant stays clean.
+        let towards = |amplitude: i32| -> Result<i64, ModelError> {
+            Ok(s * model
+                .force(point, Q1_31::from_bits(amplitude))?
+                .drive_ratio
+                .to_bits() as i64)
         };
-        let proposed = invert(candidate.correction())?;
-        let clamp = match (proposed.reach, centre_positive) {
+        let g_here = towards(here)?;
+        const PROBE: i32 = 1 << 21; // 1e-3 of full scale
+        let secant = self.previous.and_then(|(a0, g0)| {
+            let da = i64::from(here) - i64::from(a0);
+            // Usable when the two points are apart and on a rising stretch.
+            (da.abs() >= i64::from(PROBE) / 4 && (g_here - g0) * da.signum() > 0)
+                .then_some((da, g_here - g0))
+        });
+        let (da, dg) = match secant {
+            Some(slope) => slope,
+            None => {
+                let probe = if here > Q1_31::MAX.to_bits() - PROBE {
+                    here - PROBE
+                } else {
+                    here + PROBE
+                };
+                let g_probe = towards(probe)?;
+                (i64::from(probe) - i64::from(here), g_probe - g_here)
+            }
+        };
+        let newton = |correction: Q2_30| -> (i32, Reach) {
+            // The command in units of mu F_n, Q.30 (within a few Coulomb forces: fits i64).
+            let wanted = s * (((target_q16 << 30) / coulomb) + correction.to_bits() as i64);
+            let next = if dg * da.signum() <= 0 {
+                // Falling or flat: the rising branch lies above.
+                i64::from(here) + 16 * i64::from(PROBE)
+            } else {
+                i64::from(here) + ((wanted - g_here) as i128 * da as i128 / dg as i128) as i64
+            };
+            if next >= i64::from(Q1_31::MAX.to_bits()) {
+                (Q1_31::MAX.to_bits(), Reach::BelowMinimum)
+            } else if next <= 0 {
+                (0, Reach::AboveNatural)
+            } else {
+                (next as i32, Reach::Reached)
+            }
+        };
+        let (_, proposed_reach) = newton(candidate.correction());
+        let clamp = match (proposed_reach, centre_positive) {
             (Reach::Reached, _) => Clamp::Free,
             // Full drive: pushing further towards the centre changes nothing.
             (Reach::BelowMinimum, true) | (Reach::AboveNatural, false) => Clamp::Upper,
             (Reach::BelowMinimum, false) | (Reach::AboveNatural, true) => Clamp::Lower,
         };
         let correction = self.pi.commit(gains, candidate, clamp);
-        let inversion = if correction == candidate.correction() {
-            proposed
-        } else {
-            invert(correction)?
-        };
+        let (amplitude, reach) = newton(correction);
+        self.previous = Some((here, g_here));
+        self.commanded = amplitude;
         Ok(HoldStep::Motor {
-            amplitude: inversion.amplitude,
-            reach: inversion.reach,
+            amplitude: Q1_31::from_bits(amplitude),
+            reach,
             correction,
         })
     }

@@ -313,10 +313,14 @@ impl MotorScene {
     ///
     /// The force's component towards the centreline, -sgn(x) F_t, grows with the amplitude
     /// for a held block (L0(k) / I0(k) increases with k) and for a block moving towards the
-    /// centreline (the face outruns it over a longer part of the period); for a block moving
-    /// away from the centreline it is not monotone (plain friction towards the centre at low
-    /// amplitude, the smaller motor force beyond the Littmann edge), and the inversion is
-    /// refused with `OutOfDomain` rather than answered wrongly. At the node (sin(pi x/L) = 0)
+    /// centreline (the face outruns it over a longer part of the period). For a block moving
+    /// away from the centreline it is not monotone: plain friction towards the centre (mu F_n)
+    /// while the face is slower than the block, falling beyond the Littmann edge to a least
+    /// value, then growing with the motor drive. The inversion then answers on that last,
+    /// rising branch (the motor's: the same sense as the other cases, so the hold's PI and its
+    /// clamps mean the same), whose foot is found first by bisection on the slope's sign
+    /// (16 halvings, two evaluations each: about three times the cost); a target below the
+    /// least force is `AboveNatural` at the foot's amplitude. At the node (sin(pi x/L) = 0)
     /// the force towards +x is taken as the centre direction (it is 0 for a held block at
     /// every amplitude). Reach: `AboveNatural` with amplitude 0 when the target's component
     /// towards the centre is at or below the force without vibration; `BelowMinimum` with
@@ -332,20 +336,32 @@ impl MotorScene {
         } else {
             1
         };
-        if s * point.block_velocity.to_bits() as i64 > 0 {
-            return Err(ModelError::OutOfDomain {
-                input: "v_b",
-                reason: "the block moves away from the centreline: its force is not monotone \
-                         in the amplitude",
-            });
-        }
         // Components towards the centreline, Q16.16 bits.
         let towards = |force: Q16_16| -s * force.to_bits() as i64;
         let wanted = towards(target);
-        let none = self.force(point, Q1_31::ZERO)?;
+        // The foot of the rising branch: 0, or for a block moving away the least force's
+        // amplitude (the slope test steps right on a flat stretch: the plateau below the
+        // Littmann edge and the flat bottom both lie left of the rising branch).
+        let mut foot = 0i32;
+        if s * point.block_velocity.to_bits() as i64 > 0 {
+            const SLOPE_STEP: i32 = 1 << 16; // 3e-5 of full scale
+            let (mut low, mut high) = (0i32, Q1_31::MAX.to_bits() - SLOPE_STEP);
+            for _ in 0..super::BISECTION_STEPS {
+                let mid = low + (high - low) / 2;
+                let here = towards(self.force(point, Q1_31::from_bits(mid))?.force);
+                let right = towards(self.force(point, Q1_31::from_bits(mid + SLOPE_STEP))?.force);
+                if right > here {
+                    high = mid;
+                } else {
+                    low = mid;
+                }
+            }
+            foot = high;
+        }
+        let none = self.force(point, Q1_31::from_bits(foot))?;
         if wanted <= towards(none.force) {
             return Ok(ForceInversion {
-                amplitude: Q1_31::ZERO,
+                amplitude: Q1_31::from_bits(foot),
                 force: none,
                 reach: Reach::AboveNatural,
             });
@@ -359,7 +375,7 @@ impl MotorScene {
             });
         }
         // Invariant: towards(force(low)) < wanted <= towards(force(high)).
-        let (mut low, mut high) = (0i32, Q1_31::MAX.to_bits());
+        let (mut low, mut high) = (foot, Q1_31::MAX.to_bits());
         let mut at_high = full;
         for _ in 0..super::BISECTION_STEPS {
             let mid = low + (high - low) / 2;

@@ -258,15 +258,44 @@ fn holding_a_block_against_an_external_load() {
         .unwrap();
     assert_eq!(outward.reach, Reach::AboveNatural);
     assert_eq!(outward.amplitude, Q1_31::ZERO);
-    // A block moving away from the centre: refused, not answered wrongly.
-    assert!(
+    // A block moving away from the centre: answered on the motor's rising branch, above
+    // the least force (about 4.3 N at 120 N and 5 mm/s, near a tenth of full drive:
+    // `sonolube eval motor_force ... v_b=-0.005`), with the branch's foot for a target below.
+    let away = point(-0.0254, 120.0, -0.005);
+    let rising = scene
+        .amplitude_for_force(&away, Q16_16::from_f64(14.0).unwrap())
+        .unwrap();
+    assert_eq!(rising.reach, Reach::Reached);
+    assert!((rising.force.force.to_f64() - 14.0).abs() < 2e-3);
+    let least = scene
+        .amplitude_for_force(&away, Q16_16::from_f64(3.0).unwrap())
+        .unwrap();
+    assert_eq!(least.reach, Reach::AboveNatural);
+    assert!(least.amplitude < rising.amplitude);
+    // The foot is the least force over a dense scan, and the force rises beyond it.
+    let at = |bits: i64| {
         scene
-            .amplitude_for_force(
-                &point(-0.0254, 120.0, -0.005),
-                Q16_16::from_f64(5.0).unwrap()
-            )
-            .is_err()
+            .force(&away, Q1_31::from_bits(bits as i32))
+            .unwrap()
+            .force
+            .to_f64()
+    };
+    let max = Q1_31::MAX.to_bits() as i64;
+    let foot = least.amplitude.to_bits() as i64;
+    let scan_min = (0..=512)
+        .map(|k| at(k * max / 512))
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        least.force.force.to_f64() <= scan_min + 2e-3,
+        "foot {} vs scan {scan_min}",
+        least.force.force.to_f64()
     );
+    let mut last = least.force.force.to_f64();
+    for k in 1..=64 {
+        let f = at(foot + (max - foot) * k / 64);
+        assert!(f >= last - 1e-4, "not rising beyond the foot at {k}");
+        last = f;
+    }
     // Moving towards the centre at 5 mm/s: monotone, reachable.
     let inward = scene
         .amplitude_for_force(
