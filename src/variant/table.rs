@@ -35,7 +35,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl update",
-        instructions: 39.829,
+        instructions: 39.897,
     },
     Cost {
         variant: "Dahl update f32 micromath",
@@ -51,7 +51,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 296.323,
+        instructions: 296.372,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
@@ -59,7 +59,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 259.411,
+        instructions: 259.117,
     },
     Cost {
         variant: "Coulomb ratio f64",
@@ -67,207 +67,207 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11353.333,
+        instructions: 11363.655,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 5869.408,
+        instructions: 5869.623,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 31846.021,
+        instructions: 31846.074,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 147230.27,
+        instructions: 147230.16,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20281.236,
+        instructions: 20291.506,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
-        instructions: 11294.516,
+        instructions: 11294.408,
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 58659.03,
+        instructions: 58658.816,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 269832.6,
+        instructions: 269835.0,
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 37995.914,
+        instructions: 38005.914,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22175.86,
+        instructions: 22176.182,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 111924.35,
+        instructions: 111925.43,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 511148.2,
+        instructions: 511149.2,
     },
     Cost {
         variant: "Dahl steady T=49x73",
-        instructions: 322.419,
+        instructions: 322.096,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 591.515,
+        instructions: 590.961,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
-        instructions: 378.03,
+        instructions: 377.82,
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 263.03,
+        instructions: 263.076,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9423.484,
+        instructions: 9437.756,
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 829.696,
+        instructions: 829.038,
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 631.666,
+        instructions: 631.987,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
-        instructions: 393.333,
+        instructions: 393.397,
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15228.939,
+        instructions: 15243.653,
     },
     Cost {
         variant: "cube el N=16",
-        instructions: 1305.606,
+        instructions: 1304.807,
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
-        instructions: 1141.818,
+        instructions: 1141.858,
     },
     Cost {
         variant: "cube el N=16 f32 libm",
-        instructions: 657.575,
+        instructions: 657.628,
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26879.393,
+        instructions: 26895.896,
     },
     Cost {
         variant: "cube el N=32",
-        instructions: 2258.03,
+        instructions: 2257.051,
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.515,
+        instructions: 2161.987,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
-        instructions: 1183.787,
+        instructions: 1183.846,
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50123.637,
+        instructions: 50148.59,
     },
     Cost {
         variant: "cube el T=5x5",
-        instructions: 282.878,
+        instructions: 282.82,
     },
     Cost {
         variant: "cube el T=9x9",
-        instructions: 282.878,
+        instructions: 282.756,
     },
     Cost {
         variant: "cube el T=17x17",
-        instructions: 282.727,
+        instructions: 282.756,
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 591.666,
+        instructions: 590.833,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 378.181,
+        instructions: 378.076,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
-        instructions: 262.878,
+        instructions: 263.076,
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9414.696,
+        instructions: 9428.653,
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 830.0,
+        instructions: 828.974,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 632.121,
+        instructions: 631.794,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
-        instructions: 393.787,
+        instructions: 393.653,
     },
     Cost {
         variant: "cube ep N=8 f64",
-        instructions: 15216.363,
+        instructions: 15231.346,
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1306.06,
+        instructions: 1304.807,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
-        instructions: 1141.818,
+        instructions: 1141.987,
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 657.878,
+        instructions: 657.628,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26867.879,
+        instructions: 26885.77,
     },
     Cost {
         variant: "cube ep N=32",
-        instructions: 2257.878,
+        instructions: 2256.858,
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
-        instructions: 2161.515,
+        instructions: 2161.858,
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
-        instructions: 1183.787,
+        instructions: 1183.91,
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50110.605,
+        instructions: 50137.242,
     },
     Cost {
         variant: "cube ep T=5x5",
-        instructions: 282.878,
+        instructions: 282.884,
     },
     Cost {
         variant: "cube ep T=9x9",
-        instructions: 282.727,
+        instructions: 282.756,
     },
     Cost {
         variant: "cube ep T=17x17",
-        instructions: 282.878,
+        instructions: 282.628,
     },
 ];
 
@@ -1253,97 +1253,97 @@ static ERRORS: &[SceneError] = &[
 static STEPS: &[StepCost] = &[
     StepCost {
         variant: "Coulomb ratio",
-        mean: 3209.92,
+        mean: 3229.92,
         longest: 3520,
     },
     StepCost {
         variant: "Dahl steady N=16",
-        mean: 210266.88,
-        longest: 262160,
+        mean: 210488.64,
+        longest: 262440,
     },
     StepCost {
         variant: "Dahl steady N=32",
-        mean: 380328.3,
-        longest: 473920,
+        mean: 380549.6,
+        longest: 474200,
     },
     StepCost {
         variant: "Dahl steady N=64",
-        mean: 715292.2,
-        longest: 891920,
+        mean: 715512.6,
+        longest: 892200,
     },
     StepCost {
         variant: "Dahl steady T=49x73",
-        mean: 3862.4,
-        longest: 4480,
+        mean: 3882.08,
+        longest: 4520,
     },
     StepCost {
         variant: "cube el N=4",
-        mean: 4698.756,
+        mean: 4717.156,
         longest: 6280,
     },
     StepCost {
         variant: "cube el N=8",
-        mean: 5689.327,
+        mean: 5706.974,
         longest: 7760,
     },
     StepCost {
         variant: "cube el N=16",
-        mean: 7665.854,
+        mean: 7684.036,
         longest: 10800,
     },
     StepCost {
         variant: "cube el N=32",
-        mean: 11622.814,
-        longest: 16840,
+        mean: 11640.516,
+        longest: 16880,
     },
     StepCost {
         variant: "cube el T=5x5",
-        mean: 3729.069,
-        longest: 3840,
+        mean: 3745.185,
+        longest: 3880,
     },
     StepCost {
         variant: "cube el T=9x9",
-        mean: 3756.28,
+        mean: 3771.243,
         longest: 3880,
     },
     StepCost {
         variant: "cube el T=17x17",
-        mean: 3765.789,
-        longest: 3920,
+        mean: 3779.745,
+        longest: 3880,
     },
     StepCost {
         variant: "cube ep N=4",
-        mean: 4701.225,
-        longest: 6200,
+        mean: 4719.68,
+        longest: 6240,
     },
     StepCost {
         variant: "cube ep N=8",
-        mean: 5688.643,
+        mean: 5706.927,
         longest: 7760,
     },
     StepCost {
         variant: "cube ep N=16",
-        mean: 7667.603,
-        longest: 10760,
+        mean: 7685.84,
+        longest: 10800,
     },
     StepCost {
         variant: "cube ep N=32",
-        mean: 11626.8,
+        mean: 11645.072,
         longest: 16880,
     },
     StepCost {
         variant: "cube ep T=5x5",
-        mean: 3729.196,
-        longest: 3840,
+        mean: 3745.709,
+        longest: 3880,
     },
     StepCost {
         variant: "cube ep T=9x9",
-        mean: 3756.92,
+        mean: 3771.41,
         longest: 3880,
     },
     StepCost {
         variant: "cube ep T=17x17",
-        mean: 3766.61,
+        mean: 3780.734,
         longest: 3880,
     },
 ];
