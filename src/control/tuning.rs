@@ -97,6 +97,26 @@ pub fn contact_lag_s(mu: f64, k_t_n_per_m: Option<f64>, load_n: f64, speed_m_per
     }
 }
 
+/// Time for the soft start's ceiling to rise by full scale, s: the transducer's envelope time
+/// constant `2Q / w0`, at most `baseline_s` (the baseline's 5 ms).
+///
+/// The soft start keeps the drive from stepping at `start` (and when sliding resumes): the
+/// stack's amplitude follows the drive through the envelope, a first-order lag of time
+/// constant `tau = 2Q / w0`, so a ceiling rising full scale in `tau` already rises no faster
+/// than the amplitude can, and a slower one only delays the loop. The running loop's own
+/// command is bounded by the slew limit and the actuator ratings, which the soft start does
+/// not replace. With the baseline's fixed 5 ms (6 envelope time constants at the reference's
+/// 0.8 ms) a loop started after its target stepped spent 3 ms under the ceiling: `freq auto`
+/// locks at a seed-dependent 3.9-6.0 ms on the reference rig, after the reference's step at
+/// 5 ms on seed 4 (settling 4.5 ms; docs/robustness.md).
+pub fn soft_start_full_scale_s(envelope_time_constant_s: f64, baseline_s: f64) -> f64 {
+    if envelope_time_constant_s > 0.0 {
+        libm::fmin(envelope_time_constant_s, baseline_s)
+    } else {
+        baseline_s
+    }
+}
+
 /// How long the fast gains are held, in observation lags ([`observation_lag_s`]): the observed
 /// model error rises with the lag chain's step response, so the hold lasts until it is within
 /// about e^-3 (5 %) of its new value; after that it is constant and the gain falls by the
@@ -275,6 +295,9 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
             scene.normal_load_n.first().map_or(0.0, |p| p.value),
             start_speed,
         ) / (1.0 - DECLARED_MODEL_MISMATCH),
+        // The soft start's ceiling rises full scale in one envelope time constant
+        // ([`soft_start_full_scale_s`]).
+        ramp_up_full_scale_s: soft_start_full_scale_s(envelope, reference.ramp_up_full_scale_s),
         // The lead cannot make the envelope slower than it is.
         response_time_constant_s: libm::fmin(reference.response_time_constant_s, envelope),
         kp,
@@ -420,6 +443,19 @@ mod tests {
         assert!((s.tangential_force_range_n - 2.2).abs() < 1e-12);
         assert_eq!(s.velocity_range_m_s, 5.0);
         assert!(crate::control::Config::new(&s).is_ok());
+    }
+
+    #[test]
+    fn the_soft_start_rises_as_fast_as_the_envelope() {
+        // The reference: Q = 100 at 40 kHz, tau = 0.796 ms: the ceiling rises full scale in
+        // tau (0.0126 per 0.1 ms step), not the baseline's 5 ms.
+        let s = controller_settings(find("reference").expect("built in"));
+        assert!((s.ramp_up_full_scale_s - s.envelope_time_constant_s).abs() < 1e-15);
+        assert!((s.ramp_up_full_scale_s - 0.000_795_8).abs() < 1e-7);
+        // A transducer slower than the baseline keeps the baseline; a degenerate one too.
+        assert_eq!(soft_start_full_scale_s(8e-3, 5e-3), 5e-3);
+        assert_eq!(soft_start_full_scale_s(0.0, 5e-3), 5e-3);
+        assert_eq!(soft_start_full_scale_s(f64::NAN, 5e-3), 5e-3);
     }
 
     #[test]
