@@ -8,7 +8,7 @@
 
 use super::config::{ConfigError, Settings};
 use super::limits::ActuatorRatings;
-use crate::scene::{LoadCell, Scene};
+use crate::scene::{Criterion, LoadCell, Scene};
 
 /// Bandwidth of both force filters, Hz.
 ///
@@ -115,6 +115,54 @@ pub fn soft_start_full_scale_s(envelope_time_constant_s: f64, baseline_s: f64) -
     } else {
         baseline_s
     }
+}
+
+/// The shortest response time constant of the drive's lead, s, at which a plant that reduces
+/// the friction `1 + m` times as much as the model (`m` the declared mismatch) overshoots a
+/// target step by at most the fraction `overshoot` of the step; `baseline_s` (the lead's
+/// 0.25 ms) when no bound is asked (`None`) or needed (`m <= overshoot`).
+///
+/// The lead makes the envelope follow the desired amplitude as a first-order lag of time
+/// constant `tau_r` (`control/shaper.rs`), so the plant's friction moves by `(1 + m) (1 -
+/// e^(-t / tau_r))` of the step while the model error is on its way to the PI through the
+/// stages after the friction (the cell and the force filter: `delay_s`, taken as a dead time,
+/// which no feedback shortens; a compliant contact's relaxation lies before the friction and
+/// only slows its approach further). Once it arrives the correction follows it, so
+/// the friction is `x(t) + m (x(t) - x(t - delay))`, whose peak, at `t = delay`, passes the
+/// target by `m - (1 + m) e^(-delay / tau_r)` of the step. It stays within `overshoot` for
+/// `tau_r >= delay / ln((1 + m) / (m - overshoot))`. Reference: delay 0.716 ms (79.6 us +
+/// 0.637 ms), m 0.2, 5 %: ln 8 = 2.08, tau_r >= 0.344 ms (the baseline's 0.25 ms
+/// lets the peak reach 11 % of the step in this model; a plant near the mismatch grid's mu
+/// x1.3 k_t x2 corner overshot 5.0-6.7 %, docs/control-and-scenes.md).
+pub fn overshoot_bounded_response_s(
+    delay_s: f64,
+    mismatch: f64,
+    overshoot: Option<f64>,
+    baseline_s: f64,
+) -> f64 {
+    match overshoot {
+        Some(o) if o >= 0.0 && mismatch > o && delay_s > 0.0 => {
+            let bound = delay_s / libm::log((1.0 + mismatch) / (mismatch - o));
+            if bound.is_finite() {
+                libm::fmax(bound, baseline_s)
+            } else {
+                baseline_s
+            }
+        }
+        _ => baseline_s,
+    }
+}
+
+/// The tightest overshoot criterion of `scene`, as a fraction of the step; `None` without one.
+pub fn overshoot_criterion(scene: &Scene<'_>) -> Option<f64> {
+    scene
+        .criteria
+        .iter()
+        .filter_map(|criterion| match criterion {
+            Criterion::Overshoot { max_pct } => Some(max_pct / 100.0),
+            _ => None,
+        })
+        .reduce(libm::fmin)
 }
 
 /// How long the fast gains are held, in observation lags ([`observation_lag_s`]): the observed
@@ -393,6 +441,23 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
         design_load_n: scene.contents.load_min_n,
         ..reference
     };
+    // The lead no faster than a plant of the declared mismatch allows under the scene's
+    // overshoot criterion ([`overshoot_bounded_response_s`]), and never slower than the
+    // envelope itself.
+    let after_friction =
+        settings.sensor_lag_s + 1.0 / (core::f64::consts::TAU * settings.tangential_bandwidth_hz);
+    let settings = Settings {
+        response_time_constant_s: libm::fmin(
+            overshoot_bounded_response_s(
+                after_friction,
+                settings.model_mismatch,
+                overshoot_criterion(scene),
+                settings.response_time_constant_s,
+            ),
+            envelope,
+        ),
+        ..settings
+    };
     // The scene schema bounds the noise to [0, 10] % FS and the loads to positive values,
     // and the mismatch is the constant above: the rule accepts them.
     tuned(&settings).unwrap_or(settings)
@@ -512,14 +577,14 @@ mod tests {
         assert_eq!(s.natural_prior_weight, NATURAL_PRIOR_WEIGHT);
         assert_eq!(s.sliding_debounce_s, SLIDING_DEBOUNCE_S);
         // The rule: kiT capped at 1 - 0.2 - 0.3 = 0.5 (the noise allows 38 000 /s), held for
-        // three lags of 0.25 ms + 79.6 us + 0.637 ms.
+        // three lags of 0.344 ms + 1.1 us + 79.6 us + 0.637 ms.
         assert_eq!(s.kp_fast, 0.3);
         assert!(
             (s.ki_fast_per_s - 5_000.0).abs() < 1e-6,
             "{}",
             s.ki_fast_per_s
         );
-        // (three lags: 0.25 ms + 1.09 us of contact, 0.2 x 4.155 N / (0.8 x 25 N/um x
+        // (three lags: the lead's 0.344 ms (its overshoot bound) + 1.09 us of contact, 0.2 x 4.155 N / (0.8 x 25 N/um x
         // 0.038 m/s), + 79.6 us + 0.637 ms.)
         assert!(
             (s.contact_lag_s - 1.093_6e-6).abs() < 1e-9,
@@ -527,7 +592,7 @@ mod tests {
             s.contact_lag_s
         );
         assert!(
-            (s.boost_hold_s - 3.0 * 0.967_3e-3).abs() < 1e-6,
+            (s.boost_hold_s - 3.0 * (0.344_4e-3 + 0.717_3e-3)).abs() < 1e-6,
             "{}",
             s.boost_hold_s
         );
@@ -562,6 +627,69 @@ mod tests {
         assert_eq!(soft_start_full_scale_s(8e-3, 5e-3), 5e-3);
         assert_eq!(soft_start_full_scale_s(0.0, 5e-3), 5e-3);
         assert_eq!(soft_start_full_scale_s(f64::NAN, 5e-3), 5e-3);
+    }
+
+    /// The peak overshoot, fraction of the step, of `y(t) = (1 + m) x(t)` before the dead time
+    /// `delay` and `x(t) + m (x(t) - x(t - delay))` after it, `x` the unit step through a
+    /// first-order lag `tau`: stepped in time (1 us) rather than taken from the closed form.
+    fn delayed_correction_peak(delay: f64, mismatch: f64, tau: f64) -> f64 {
+        let x = |t: f64| if t > 0.0 { 1.0 - (-t / tau).exp() } else { 0.0 };
+        (0..20_000)
+            .map(|k| {
+                let t = k as f64 * 1e-6;
+                let y = if t < delay {
+                    (1.0 + mismatch) * x(t)
+                } else {
+                    x(t) + mismatch * (x(t) - x(t - delay))
+                };
+                y - 1.0
+            })
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn the_lead_is_slowed_until_the_mismatch_cannot_overshoot() {
+        // The reference: 0.716 ms after the friction (the cell, the filter), m 0.2, 5 %:
+        // 0.344 ms.
+        let s = controller_settings(find("reference").expect("built in"));
+        let delay = s.sensor_lag_s + 1.0 / (core::f64::consts::TAU * s.tangential_bandwidth_hz);
+        assert!((delay - 0.716_2e-3).abs() < 1e-6, "{delay}");
+        let tau = overshoot_bounded_response_s(delay, 0.2, Some(0.05), 0.25e-3);
+        assert!((tau - delay / 8f64.ln()).abs() < 1e-12);
+        assert!((tau - 0.344_4e-3).abs() < 1e-6, "{tau}");
+        assert_eq!(s.response_time_constant_s, tau);
+        // At the bound the stepped model peaks at the criterion; the baseline's 0.25 ms, at 11 %.
+        let peak = delayed_correction_peak(delay, 0.2, tau);
+        assert!((peak - 0.05).abs() < 1e-3, "{peak}");
+        assert!(delayed_correction_peak(delay, 0.2, 0.25e-3) > 0.10);
+        // No criterion, or a mismatch the criterion already covers: the baseline.
+        assert_eq!(
+            overshoot_bounded_response_s(delay, 0.2, None, 0.25e-3),
+            0.25e-3
+        );
+        assert_eq!(
+            overshoot_bounded_response_s(delay, 0.05, Some(0.05), 0.25e-3),
+            0.25e-3
+        );
+        // A bound faster than the baseline keeps the baseline.
+        assert_eq!(
+            overshoot_bounded_response_s(1e-5, 0.2, Some(0.05), 0.25e-3),
+            0.25e-3
+        );
+        // Bad input: the baseline, no panic.
+        assert_eq!(
+            overshoot_bounded_response_s(f64::NAN, 0.2, Some(0.05), 0.25e-3),
+            0.25e-3
+        );
+        assert_eq!(
+            overshoot_bounded_response_s(delay, 0.2, Some(-1.0), 0.25e-3),
+            0.25e-3
+        );
+        // The scene's tightest overshoot criterion.
+        assert_eq!(
+            overshoot_criterion(find("reference").expect("built in")),
+            Some(0.05)
+        );
     }
 
     #[test]
