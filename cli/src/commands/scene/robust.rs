@@ -823,9 +823,10 @@ fn envelope(scene: &Scene<'_>, seeds: &[u64], jobs: usize, out: &Path) -> Result
 }
 
 /// Below 1 N the cells' noise, not the physics, limits the steady error: for each such load
-/// the RMS error the noise predicts ([`sonolube::control::noise_rms_error`]: mu0's standard
-/// error after its learning, from the point's tuning and cells) beside the measured RMS error
-/// (mean and worst of the load's runs).
+/// the RMS error the noise predicts through the loop
+/// ([`sonolube::control::steady_noise_rms_error`]: the steady PI's share of the measured
+/// ratio's noise and mu0's standard error after its learning, from the point's tuning, cells
+/// and target) beside the measured RMS error (mean and worst of the load's runs).
 fn noise_prediction(
     scene: &Scene<'_>,
     points: &[super::grid::EnvelopePoint],
@@ -841,7 +842,7 @@ fn noise_prediction(
         return;
     };
     println!(
-        "  below 1 N, RMS error the cells' noise predicts (mu0's standard error) and measured:"
+        "  below 1 N, RMS error the cells' noise predicts (steady PI and mu0's learning) and measured:"
     );
     println!(
         "  {:>6} {:>14} {:>14} {:>14}",
@@ -864,9 +865,18 @@ fn noise_prediction(
                 .find(|&t| t > 0.0)
                 .unwrap_or(point_scene.duration_s);
             let learn_s = (change_s - settings.sliding_debounce_s).max(settings.natural_learn_s);
-            if let Some(e) = sonolube::control::noise_rms_error(&settings, learn_s) {
-                predicted.push(100.0 * e);
-            }
+            let friction_n = (1.0 - point.reduction_pct / 100.0) * settings.natural_prior * load;
+            predicted.push(
+                100.0
+                    * sonolube::control::steady_noise_rms_error(
+                        &settings,
+                        settings.tangential_noise_n,
+                        settings.normal_noise_n,
+                        friction_n,
+                        *load,
+                        learn_s,
+                    ),
+            );
             for r in results[k * seeds..(k + 1) * seeds].iter().flatten() {
                 if let Some(v) = r.verdicts.get(rms_index).and_then(|v| value_of(v.measured)) {
                     measured.push(v);
