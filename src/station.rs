@@ -473,14 +473,8 @@ impl Station {
     fn start_after_search(&mut self, command: &Command) -> Result<(), ProtocolError> {
         let mut probe = self.controller;
         probe.start().map_err(|e| e.to_protocol())?;
-        let resonance = self.resonance.as_mut().ok_or(ProtocolError::Unavailable {
-            command: command.keyword(),
-            reason: self.resonance_refused,
-        })?;
-        resonance.search().map_err(|_| ProtocolError::Unavailable {
-            command: command.keyword(),
-            reason: "the timer cannot make the search's frequencies",
-        })?;
+        let resonance = self.resonance_loop(command)?;
+        search_now(resonance, command)?;
         self.auto_armed = false;
         self.start_pending = true;
         Ok(())
@@ -494,6 +488,14 @@ impl Station {
         self.pin_here();
     }
 
+    /// The stack's resonance loop, or `command` refused for the reason it has none.
+    fn resonance_loop(&mut self, command: &Command) -> Result<&mut ResonanceLoop, ProtocolError> {
+        self.resonance.as_mut().ok_or(ProtocolError::Unavailable {
+            command: command.keyword(),
+            reason: self.resonance_refused,
+        })
+    }
+
     /// `freq auto`: the resonance loop searches now with the drive on, or at the next `start`
     /// with it off. Refused where the board or the scene gives no current samples, or the
     /// stack has no loop.
@@ -504,21 +506,18 @@ impl Station {
                 reason: self.no_current_reason,
             });
         }
-        let resonance = self.resonance.as_mut().ok_or(ProtocolError::Unavailable {
-            command: command.keyword(),
-            reason: self.resonance_refused,
-        })?;
-        match self.controller.state() {
-            SupervisorState::RampUp | SupervisorState::Running => {
-                resonance.search().map_err(|_| ProtocolError::Unavailable {
-                    command: command.keyword(),
-                    reason: "the timer cannot make the search's frequencies",
-                })?;
-            }
+        let drive_on = matches!(
+            self.controller.state(),
+            SupervisorState::RampUp | SupervisorState::Running
+        );
+        let resonance = self.resonance_loop(command)?;
+        if drive_on {
+            search_now(resonance, command)
+        } else {
             // Drive off: the search runs at the next `start`.
-            _ => self.auto_armed = true,
+            self.auto_armed = true;
+            Ok(())
         }
-        Ok(())
     }
 
     /// `freq HZ`: the drive pinned at `freq_chz`, with the current rating's ceiling there.
@@ -832,4 +831,13 @@ fn sense(channel: &mut SensorChannel, code: u16, sensor: Sensor) -> (Q16_16, Opt
         Err(SampleError::Code(_)) => SensorFaultKind::OutOfRange,
     };
     (Q16_16::ZERO, Some(SensorFault { sensor, kind }))
+}
+
+/// Starts `resonance`'s search now, or refuses `command` when the drive's timer cannot make
+/// the search's frequencies.
+fn search_now(resonance: &mut ResonanceLoop, command: &Command) -> Result<(), ProtocolError> {
+    resonance.search().map_err(|_| ProtocolError::Unavailable {
+        command: command.keyword(),
+        reason: "the timer cannot make the search's frequencies",
+    })
 }

@@ -105,14 +105,8 @@ impl Station {
                 reason: "this board does not sample the drive current",
             });
         }
-        let resonance = self.resonance.as_mut().ok_or(ProtocolError::Unavailable {
-            command: command.keyword(),
-            reason: self.resonance_refused,
-        })?;
-        resonance.search().map_err(|_| ProtocolError::Unavailable {
-            command: command.keyword(),
-            reason: "the timer cannot make the search's frequencies",
-        })?;
+        let resonance = self.resonance_loop(command)?;
+        super::search_now(resonance, command)?;
         // Half the ceiling the ratings allow at the present frequency: the burst rings the
         // stack well above the sense's noise and within its current rating.
         let ceiling = self.controller.config().limit().max_amplitude;
