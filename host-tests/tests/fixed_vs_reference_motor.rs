@@ -187,19 +187,8 @@ fn held_block_against_an_external_load_nets_zero_in_the_reference() {
     use sonolube::model::Reach;
     use sonolube::model::horn::{HornShape, UPhase};
     use sonolube::model::motor::{MotorParams, MotorPoint, MotorScene};
-    let scene = MotorScene::new(
-        &MotorParams {
-            friction_coefficient: 0.55,
-            longitudinal_amplitude: 11.46e-6,
-            vertical_amplitude: 1.1e-6,
-            horn_length: 0.127,
-            frequency: 20e3,
-            roughness_rq: 6e-6,
-            distribution_lambda: 3.0,
-        },
-        UPhase::Quadrature,
-    )
-    .unwrap();
+    let scene =
+        MotorScene::new(&MotorParams::SEED_001_AL_HORN_SS_BLOCK, UPhase::Quadrature).unwrap();
     let mut reached = 0;
     for x in [
         -1.5 * INCH,

@@ -210,12 +210,8 @@ mod tests {
         MotorScene::new(
             &MotorParams {
                 friction_coefficient: mu,
-                longitudinal_amplitude: 11.46e-6,
                 vertical_amplitude: b,
-                horn_length: 0.127,
-                frequency: 20e3,
-                roughness_rq: 6e-6,
-                distribution_lambda: 3.0,
+                ..MotorParams::SEED_001_AL_HORN_SS_BLOCK
             },
             UPhase::Quadrature,
         )

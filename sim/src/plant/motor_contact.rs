@@ -131,19 +131,8 @@ mod tests {
 
     /// Seed 000 Tables 1-2 (Al horn, SS block), mu 0.55 (seed 001 §3.3).
     fn block(start_m: f64) -> BlockOnHorn {
-        let motor = MotorScene::new(
-            &MotorParams {
-                friction_coefficient: 0.55,
-                longitudinal_amplitude: 11.46e-6,
-                vertical_amplitude: 1.1e-6,
-                horn_length: 0.127,
-                frequency: 20e3,
-                roughness_rq: 6e-6,
-                distribution_lambda: 3.0,
-            },
-            UPhase::Quadrature,
-        )
-        .unwrap();
+        let motor =
+            MotorScene::new(&MotorParams::SEED_001_AL_HORN_SS_BLOCK, UPhase::Quadrature).unwrap();
         BlockOnHorn::new(motor, ALUMINIUM_HORN_REGIONS, start_m).unwrap()
     }
 

@@ -96,6 +96,22 @@ pub struct MotorParams {
     pub distribution_lambda: f64,
 }
 
+impl MotorParams {
+    /// Seed 000 Tables 1-2 (aluminium horn, test 1: A = 11.46 um, B = 1.1 um, 20 kHz, L = 127
+    /// mm; stainless block, R_q = 6 um, lambda = 3) with seed 001's mu = 0.55 (its §3.3): the
+    /// one definition of the set in the firmware core. The f64 reference keeps its own copy
+    /// (`sonolube_host::reference::motor`) so that the two are written independently.
+    pub const SEED_001_AL_HORN_SS_BLOCK: Self = Self {
+        friction_coefficient: 0.55,
+        longitudinal_amplitude: 11.46e-6,
+        vertical_amplitude: 1.1e-6,
+        horn_length: 0.127,
+        frequency: 20e3,
+        roughness_rq: 6e-6,
+        distribution_lambda: 3.0,
+    };
+}
+
 /// The motor model of one scene: its constants in fixed point and its quadrature rule.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MotorScene {

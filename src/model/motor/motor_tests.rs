@@ -9,15 +9,7 @@ use crate::fx::{Q1_31, Q8_24, Q16_16};
 
 /// Seed 000 Table 1 test 1 (Al horn, SS block) and Table 2; mu 0.55 (seed 001 §3.3).
 fn seed_params() -> MotorParams {
-    MotorParams {
-        friction_coefficient: 0.55,
-        longitudinal_amplitude: 11.46e-6,
-        vertical_amplitude: 1.1e-6,
-        horn_length: 0.127,
-        frequency: 20e3,
-        roughness_rq: 6e-6,
-        distribution_lambda: 3.0,
-    }
+    MotorParams::SEED_001_AL_HORN_SS_BLOCK
 }
 
 /// I0(k) and L0(k) by their power series (k <= 16: 80 terms are far past convergence).
