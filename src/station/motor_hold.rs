@@ -22,10 +22,10 @@
 //! velocity for friction: the hold measures minus the cell's reading.
 
 use crate::control::{HoldStep, NetForceHold, NetForceTarget, Output, PiGains, Settings};
-use crate::fx::{Q1_31, Q8_24, Q16_16};
+use crate::fx::{Q1_31, Q8_24, Q16_16, Turns};
 use crate::model::ModelError;
 use crate::model::horn::HornShape;
-use crate::model::motor::{HornRegion, MeasuredRegions, MotorPoint, MotorScene, scene_motor};
+use crate::model::motor::{MotorPoint, MotorScene, classify, scene_motor};
 use crate::protocol::{SupervisorState, Target};
 use crate::scene::Scene;
 
@@ -33,11 +33,19 @@ use crate::scene::Scene;
 #[derive(Debug, Clone)]
 pub(super) struct MotorHold {
     model: MotorScene,
-    regions: MeasuredRegions,
-    /// x from the horn centre, m (f64: 0.5 um steps on centimetres, the plant's reasoning in
-    /// `sim/src/plant/motor_contact.rs`).
-    position_m: f64,
-    period_s: f64,
+    /// The block's place as the horn's position phase x / (2 L) in turns (`fx::Turns` bits,
+    /// U0.32 read as signed: |x| <= L/2 is |phase| <= 2^30), the phase `HornShape::from_phase`
+    /// takes: 2L / 2^32 per count (59 pm on the 127 mm horn), so the 0.8 um a period of a
+    /// 5 mm/s block moves is about 14,000 counts, integrated without drift or float.
+    phase: i32,
+    /// Counts per m/s of sliding velocity over one period, T 2^32 / (2 L) (scene load).
+    counts_per_m_per_s: f32,
+    /// Table 1's boundaries (`MeasuredRegions`) as phases (scene load): transition [low, high],
+    /// motor outer ends.
+    transition: (i32, i32),
+    motor_outer: (i32, i32),
+    /// The horn's length L, m (the position read back in metres).
+    horn_length_m: f64,
     gains: PiGains,
     hold: Option<NetForceHold>,
     /// The last command the hold gave (kept while the model cannot be inverted).
@@ -67,12 +75,25 @@ impl MotorHold {
             return Ok(None);
         };
         let position_m = scene.horn.map_or(0.0, |horn| horn.contact_position_m);
-        HornShape::new(position_m, model.horn_length())?;
+        let horn_length_m = model.horn_length();
+        HornShape::new(position_m, horn_length_m)?;
+        let per_m = COUNTS_PER_TURN / (2.0 * horn_length_m);
+        // A boundary beyond the face (|x| > L/2) is where the block never is: the face's end.
+        let phase_of =
+            |x: f64| libm::round(x.clamp(-0.5 * horn_length_m, 0.5 * horn_length_m) * per_m) as i32;
         Ok(Some(Self {
+            transition: (
+                phase_of(regions.transition.0),
+                phase_of(regions.transition.1),
+            ),
+            motor_outer: (
+                phase_of(regions.motor_outer.0),
+                phase_of(regions.motor_outer.1),
+            ),
             model,
-            regions,
-            position_m,
-            period_s: settings.period_s,
+            phase: phase_of(position_m),
+            counts_per_m_per_s: (settings.period_s * per_m) as f32,
+            horn_length_m,
             gains: gains(settings)?,
             hold: None,
             last_amplitude: Q1_31::ZERO,
@@ -88,7 +109,7 @@ impl MotorHold {
 
     /// The block's position, m from the horn centre.
     pub(super) fn position_m(&self) -> f64 {
-        self.position_m
+        f64::from(self.phase) * 2.0 * self.horn_length_m / COUNTS_PER_TURN
     }
 
     /// One period: the block moves at `velocity_m_per_s` over the period; with a net-force
@@ -102,10 +123,14 @@ impl MotorHold {
         normal_force: Q16_16,
         tangential_force: Q16_16,
     ) -> HoldOutcome {
-        let next = self.position_m + f64::from(velocity_m_per_s) * self.period_s;
-        // Off the face (|x| > L/2) the rig has lost the block: the position stays at the end.
-        if HornShape::new(next, self.model.horn_length()).is_ok() {
-            self.position_m = next;
+        // The period's move in counts (f32: the velocity's own type; a non-finite or huge one
+        // saturates and is then refused by the face's bound below).
+        let step = (velocity_m_per_s * self.counts_per_m_per_s) as i64;
+        let next = i64::from(self.phase) + step;
+        // Off the face (|x| > L/2, |phase| > 2^30) the rig has lost the block: the position
+        // stays where it was.
+        if next.abs() <= HALF_FACE_COUNTS {
+            self.phase = next as i32;
         }
         let Some(Target::NetForce { force_mn }) = target else {
             self.hold = None;
@@ -120,14 +145,8 @@ impl MotorHold {
             Some(hold) if hold.target() == target => hold,
             _ => self.hold.insert(NetForceHold::new(target)),
         };
-        // Finite by construction (checked at every move).
-        let region = self
-            .regions
-            .region(self.position_m)
-            .unwrap_or(HornRegion::BeyondMeasured);
-        let Ok(shape) = HornShape::new(self.position_m, self.model.horn_length()) else {
-            return HoldOutcome::Transition;
-        };
+        let region = classify(self.phase, self.transition, self.motor_outer);
+        let shape = HornShape::from_phase(Turns::from_bits(self.phase as u32));
         let point = MotorPoint {
             shape,
             normal_force,
@@ -147,6 +166,11 @@ impl MotorHold {
         }
     }
 }
+
+/// 2^32 counts per turn of the horn's position phase.
+const COUNTS_PER_TURN: f64 = 4_294_967_296.0;
+/// |x| = L/2, a quarter turn: the face's ends.
+const HALF_FACE_COUNTS: i64 = 1 << 30;
 
 fn gains(settings: &Settings) -> Result<PiGains, ModelError> {
     PiGains::new(

@@ -63,7 +63,7 @@ use super::horn::{HornShape, UPhase};
 use super::quadrature::legendre_half;
 
 pub use super::motor_regions::{
-    ALUMINIUM_HORN_REGIONS, HornRegion, MeasuredRegions, STAINLESS_HORN_REGIONS,
+    ALUMINIUM_HORN_REGIONS, HornRegion, MeasuredRegions, STAINLESS_HORN_REGIONS, classify,
 };
 use super::{ModelError, Reach};
 

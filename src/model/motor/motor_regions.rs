@@ -76,12 +76,19 @@ impl MeasuredRegions {
         if !x.is_finite() {
             return Err(ModelError::NonFinite { input: "x" });
         }
-        Ok(if self.in_transition(x) {
-            HornRegion::Transition
-        } else if self.motor_outer.0 <= x && x <= self.motor_outer.1 {
-            HornRegion::Motor
-        } else {
-            HornRegion::BeyondMeasured
-        })
+        Ok(classify(x, self.transition, self.motor_outer))
+    }
+}
+
+/// The region of position `x` given the transition region `[low, high]` and the motor regions'
+/// outer ends `[left, right]`, in any one unit of position (metres here; the station's horn
+/// phase counts, `sonolube::station`), ends included.
+pub fn classify<T: PartialOrd>(x: T, transition: (T, T), motor_outer: (T, T)) -> HornRegion {
+    if transition.0 <= x && x <= transition.1 {
+        HornRegion::Transition
+    } else if motor_outer.0 <= x && x <= motor_outer.1 {
+        HornRegion::Motor
+    } else {
+        HornRegion::BeyondMeasured
     }
 }
