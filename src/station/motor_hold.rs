@@ -79,8 +79,10 @@ impl MotorHold {
         HornShape::new(position_m, horn_length_m)?;
         let per_m = COUNTS_PER_TURN / (2.0 * horn_length_m);
         // A boundary beyond the face (|x| > L/2) is where the block never is: the face's end.
-        let phase_of =
-            |x: f64| libm::round(x.clamp(-0.5 * horn_length_m, 0.5 * horn_length_m) * per_m) as i32;
+        // max/min, not `clamp`: clamp's assertion would link f64 formatting into the board.
+        let phase_of = |x: f64| {
+            libm::round(x.max(-0.5 * horn_length_m).min(0.5 * horn_length_m) * per_m) as i32
+        };
         Ok(Some(Self {
             transition: (
                 phase_of(regions.transition.0),
