@@ -184,3 +184,74 @@ fn csv_none_writes_no_csv_and_every_n_thins_it() {
         assert_eq!(sonolube(&all).0, 2, "{bad:?}");
     }
 }
+
+/// A reduction step near what the cells resolve (mu0's learning error against the overshoot
+/// criterion) runs with a warning that gives the step, mu0's error and the chance of passing
+/// the criterion by that error alone.
+#[test]
+fn a_small_reduction_step_runs_with_the_resolution_warning() {
+    let (_, stdout, stderr) = run(
+        "small-step",
+        &[("reduction_pct = 50.0", "reduction_pct = 2.0")],
+    );
+    let all = format!("{stdout}{stderr}");
+    assert!(
+        all.contains("warning: profiles.target[1].reduction_pct: a step of 2.00 %")
+            && all.contains("40 samples")
+            && all.contains("of runs"),
+        "{all}"
+    );
+}
+
+/// The envelope sweep judges every run by the feasibility check that `scene --file` applies:
+/// each point it lists as infeasible is refused when its file is run alone, and its counts
+/// add up (refused + accepted = every run).
+#[test]
+fn the_envelope_refuses_what_scene_file_refuses() {
+    let out = std::env::temp_dir().join(format!("sonolube-envelope-{}", std::process::id()));
+    let (code, stdout, stderr) = sonolube(&[
+        "scene",
+        "reference",
+        "--envelope",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(code == 0 || code == 1, "{stderr}");
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("  the feasibility check (all runs run"))
+        .unwrap_or_else(|| panic!("no check line: {stdout}"));
+    let numbers: Vec<usize> = line
+        .split(|c: char| !c.is_ascii_digit())
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    // refused, refused-but-passed, warned, warned-passed, clean, clean-passed.
+    assert_eq!(numbers.len(), 6, "{line}");
+    assert_eq!(numbers[0] + numbers[2] + numbers[4], 60, "{line}");
+    let infeasible: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.starts_with("  INFEASIBLE ") && !l.contains("sized cells"))
+        .collect();
+    assert_eq!(infeasible.len(), numbers[0], "{stdout}");
+    // The first refused point, run alone from its file: refused the same way.
+    let first = infeasible.first().expect("the 0.5 N points are refused");
+    let load = first
+        .trim_start_matches("  INFEASIBLE ")
+        .split(" N,")
+        .next()
+        .unwrap();
+    assert_eq!(load, "0.5", "{first}");
+    let file = out.join("envelope").join("env-0p5n-10mms-9pct.toml");
+    let (code, _, stderr) = sonolube(&[
+        "scene",
+        "env-0p5n-10mms-9pct",
+        "--file",
+        file.to_str().unwrap(),
+        "--csv",
+        "none",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("refused"), "{stderr}");
+}

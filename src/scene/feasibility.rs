@@ -27,6 +27,18 @@
 //!   `sonolube scene reference --noise --seeds 20` measures 0.77 % mean, 1.27 % worst.) Above the scene's band it is refused; above half the band it is a warning (the model
 //!   error and the noise share the band).
 //!
+//! - **a reduction step against mu0's uncertainty**: a reduction target is relative to mu0,
+//!   learned from the cells while the contact slides with the drive off before the first target
+//!   asks for drive; its standard error `sqrt((sigma_t / (mu0 W))^2 + (sigma_n / W)^2) / sqrt(n)`
+//!   (`n` samples) holds the friction off every later reduction target by that fraction of the
+//!   target friction, a steady offset no feedback sees. Past the target it is overshoot, judged
+//!   against the step: when one standard error of mu0 is more than half the scene's overshoot
+//!   criterion, the step is near what the cells resolve and the run may fail by mu0's error
+//!   alone (with probability `P(z > criterion / error)`, one-sided: more than 2.3 %, and up to
+//!   one half for a step of which mu0's error is many times the criterion): a warning with that
+//!   chance, never a refusal (the error is as likely to fall short of the target as past it).
+//!   Coefficient and force targets are absolute: mu0's error does not move them.
+//!
 //! The control rate's range is the schema's (`sonolube_scene_types::CONTROL_RATE_RANGE_HZ`,
 //! the one source the loader and the controller's gains share); its period budget is checked
 //! with the model variant (`crate::variant`).
@@ -109,6 +121,24 @@ pub enum Cause {
         /// The tangential cell's per-sample noise (and quantisation), N RMS.
         tangential_noise_n: f64,
     },
+    /// A reduction step is near what the cells resolve: mu0's standard error holds the friction
+    /// off the target by more than half the overshoot criterion.
+    StepBelowResolution {
+        /// Index of the target point in `profiles.target` that steps.
+        point: usize,
+        /// The step, % of the natural friction.
+        step_pct: f64,
+        /// mu0's standard error after its learning, % of mu0 (one sigma).
+        natural_error_pct: f64,
+        /// Samples mu0 is learned from.
+        samples: f64,
+        /// The friction's offset that error gives at the new target, % of the step.
+        offset_pct_of_step: f64,
+        /// The scene's overshoot criterion, % of the step.
+        overshoot_pct: f64,
+        /// The chance that mu0's error alone takes the friction past the criterion, [0, 1/2].
+        chance_past: f64,
+    },
     /// The controller's model could not be evaluated at the scene's operating points.
     Model(ModelError),
     /// `freq auto`: the resonance search may lock after the scene's first judged instant.
@@ -142,6 +172,7 @@ impl Finding {
             Cause::TargetOutOfReach { .. } => "the target is beyond the drive's reach",
             Cause::NoSliding { .. } => "the speed is below the sliding threshold",
             Cause::Noise { .. } => "the cells' noise exceeds the accuracy band",
+            Cause::StepBelowResolution { .. } => "the step is near what the cells resolve",
             Cause::Model(_) => "the controller's model fails over the scene",
             Cause::SearchOutlastsStart { .. } => "the resonance search may outlast the first step",
         }
@@ -210,6 +241,24 @@ impl fmt::Display for Finding {
                  accuracy.friction_pct = {band_pct} %",
                 self.field
             ),
+            Cause::StepBelowResolution {
+                point,
+                step_pct,
+                natural_error_pct,
+                samples,
+                offset_pct_of_step,
+                overshoot_pct,
+                chance_past,
+            } => write!(
+                f,
+                "profiles.target[{point}].reduction_pct: a step of {step_pct:.2} % of the natural \
+                 friction; mu0, learned from {samples:.0} samples sliding with the drive off, is \
+                 known to {natural_error_pct:.3} % (one standard error, the cells' noise), which \
+                 holds the friction {offset_pct_of_step:.1} % of the step off the target: past \
+                 the overshoot criterion of {overshoot_pct} % of the step by that alone in {:.0} % \
+                 of runs",
+                100.0 * chance_past
+            ),
             Cause::Model(error) => write!(
                 f,
                 "{}: the controller's model cannot be evaluated over the scene: {error}",
@@ -234,7 +283,7 @@ impl fmt::Display for Finding {
 }
 
 /// Most findings [`check`] returns: one per check.
-pub const MAX_FINDINGS: usize = 5;
+pub const MAX_FINDINGS: usize = 6;
 
 /// The findings of [`check`], worst of each check.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -278,6 +327,7 @@ pub fn check<M: FrictionModel + ?Sized>(scene: &Scene<'_>, model: &M) -> Feasibi
     result.push(sliding(scene, &settings));
     result.push(reach(scene, &settings, model));
     result.push(noise(scene, &settings));
+    result.push(step_resolution(scene, &settings));
     result.push(search_timing(scene));
     result
 }
@@ -609,6 +659,96 @@ fn noise(scene: &Scene<'_>, settings: &Settings) -> Option<Finding> {
     Some(Finding {
         severity,
         field,
+        cause,
+    })
+}
+
+/// The time mu0 is learned before the drive first starts, s: from the sliding debounce to the
+/// first target point that asks for drive while the contact slides, at least the controller's
+/// `natural_learn_s` (the drive waits for it). `None` when no target asks for drive.
+fn learning_s(scene: &Scene<'_>, settings: &Settings) -> Option<f64> {
+    scene.target.iter().find_map(|point| {
+        let speed = speed_at(scene, point.at_s);
+        let load = f64::from(interpolate(scene.normal_load_n, point.at_s as f32));
+        let mu = scene.controller.natural_coefficient(speed);
+        (speed > settings.sliding_on_m_s
+            && load > settings.min_normal_force_n
+            && needed_ratio(point.target, mu, load) < 1.0)
+            .then(|| {
+                libm::fmax(
+                    point.at_s - settings.sliding_debounce_s,
+                    settings.natural_learn_s,
+                )
+            })
+    })
+}
+
+/// Every reduction step after the first drive against mu0's standard error (module docs):
+/// the worst step, a warning when the error is above half the scene's overshoot criterion.
+/// `None` without an overshoot criterion or a reduction step.
+fn step_resolution(scene: &Scene<'_>, settings: &Settings) -> Option<Finding> {
+    let overshoot = crate::control::overshoot_criterion(scene)?;
+    let learn_s = learning_s(scene, settings)?;
+    let samples = libm::fmax(libm::floor(learn_s / settings.period_s), 1.0);
+    let tangential = cell_noise_n(&scene.tangential_cell);
+    let normal = cell_noise_n(&scene.normal_cell);
+    // mu0's relative standard error, at the load and speed it is learned at.
+    let at_learning = |t: f64| {
+        let load = f64::from(interpolate(scene.normal_load_n, t as f32));
+        let mu = scene.controller.natural_coefficient(speed_at(scene, t));
+        libm::hypot(tangential / (mu * load), normal / load) / libm::sqrt(samples)
+    };
+    // The drive starts when the learning ends.
+    let drive_start_s = settings.sliding_debounce_s + learn_s;
+    let natural_error = at_learning(drive_start_s);
+    let mut worst: Option<Cause> = None;
+    for (index, pair) in scene.target.windows(2).enumerate() {
+        let [before, after] = pair else { continue };
+        if !matches!(after.target, Target::Reduction { .. }) || after.at_s + 1e-9 < drive_start_s {
+            continue;
+        }
+        let speed = speed_at(scene, after.at_s);
+        let load = f64::from(interpolate(scene.normal_load_n, after.at_s as f32));
+        let mu = scene.controller.natural_coefficient(speed);
+        let (from, to) = (
+            needed_ratio(before.target, mu, load),
+            needed_ratio(after.target, mu, load),
+        );
+        let step = libm::fabs(to - from);
+        if step <= 0.0 || to >= 1.0 {
+            continue;
+        }
+        let offset = to * natural_error / step;
+        let worse = match worst {
+            Some(Cause::StepBelowResolution {
+                offset_pct_of_step, ..
+            }) => 100.0 * offset > offset_pct_of_step,
+            _ => true,
+        };
+        if worse {
+            worst = Some(Cause::StepBelowResolution {
+                point: index + 1,
+                step_pct: 100.0 * step,
+                natural_error_pct: 100.0 * natural_error,
+                samples,
+                offset_pct_of_step: 100.0 * offset,
+                overshoot_pct: 100.0 * overshoot,
+                chance_past: 0.5 * libm::erfc(overshoot / offset / core::f64::consts::SQRT_2),
+            });
+        }
+    }
+    let cause = worst?;
+    let Cause::StepBelowResolution {
+        offset_pct_of_step,
+        overshoot_pct,
+        ..
+    } = cause
+    else {
+        return None;
+    };
+    (offset_pct_of_step > overshoot_pct / 2.0).then_some(Finding {
+        severity: Severity::Warn,
+        field: "profiles.target",
         cause,
     })
 }

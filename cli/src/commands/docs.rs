@@ -144,6 +144,13 @@ pub const BLOCKS: &[Block] = &[
         cost: Cost::Seconds,
     },
     Block {
+        name: "envelope",
+        run: "for a in '' ' --seeds 10'; do echo \"\\$ sonolube scene reference --envelope$a\"; SONOLUBE_JOBS=2 sonolube scene reference --envelope$a | grep -vE '^  (FAIL|INFEASIBLE) '; done",
+        show: None,
+        fence: true,
+        cost: Cost::Seconds,
+    },
+    Block {
         name: "robustness-seeds",
         run: "echo '$ sonolube scene --all --seeds 100'; SONOLUBE_JOBS=2 sonolube scene --all --seeds 100 | tail -n 1; echo '$ sonolube scene reference --mismatch --seeds 10'; SONOLUBE_JOBS=2 sonolube scene reference --mismatch --seeds 10 | tail -n 1",
         show: None,

@@ -128,7 +128,7 @@ pub fn run(
         }
     }
     let infeasible = if infeasible_runs > 0 {
-        format!("; {infeasible_runs} more infeasible, refused before running (reasons above)")
+        format!("; {infeasible_runs} more infeasible, refused (reasons above)")
     } else {
         String::new()
     };
@@ -771,14 +771,19 @@ fn envelope(scene: &Scene<'_>, seeds: &[u64], jobs: usize, out: &Path) -> Result
         runs.len(),
         seeds_text(seeds)
     );
-    let results = run_all(&runs, jobs, "envelope");
-    let stats = criterion_stats(scene, &runs, &results);
+    // What `sonolube scene --file` refuses before running is not run here either: the point
+    // is listed with the reason and counted apart (the feasibility check is seed-independent).
+    let outcome = run_feasible(&runs, jobs, "envelope");
+    let stats = criterion_stats(scene, &outcome.runs, &outcome.results);
     print!("{}", stats_table(&stats));
     // Pass counts per (load, speed).
-    println!("  runs passed per load (rows, N) and speed (columns, m/s):");
+    println!(
+        "  runs passed per load (rows, N) and speed (columns, m/s), of those the feasibility \
+         check accepts (refused ones after the +):"
+    );
     print!("  {:>6}", "");
     for speed in ENVELOPE_SPEEDS {
-        print!(" {speed:>8}");
+        print!(" {speed:>10}");
     }
     println!();
     let per_point = seeds.len() * super::grid::ENVELOPE_SHARES.len();
@@ -786,16 +791,28 @@ fn envelope(scene: &Scene<'_>, seeds: &[u64], jobs: usize, out: &Path) -> Result
         print!("  {load:>6}");
         for column in 0..ENVELOPE_SPEEDS.len() {
             let start = (row * ENVELOPE_SPEEDS.len() + column) * per_point;
-            let chunk = &results[start..start + per_point];
-            let ok = chunk.iter().filter(|r| is_pass(r)).count();
-            print!(" {:>8}", format!("{ok}/{per_point}"));
+            let chunk = &outcome.all[start..start + per_point];
+            let accepted = || chunk.iter().filter(|(_, refused)| !refused);
+            let ok = accepted().filter(|(r, _)| is_pass(r)).count();
+            let ran = accepted().count();
+            let refused = per_point - ran;
+            let cell = if refused > 0 {
+                format!("{ok}/{ran}+{refused}")
+            } else {
+                format!("{ok}/{ran}")
+            };
+            print!(" {cell:>10}");
         }
         println!();
     }
-    for line in failures(&runs, &results) {
+    for line in failures(&outcome.runs, &outcome.results) {
         println!("  FAIL {line}");
     }
-    noise_prediction(scene, &points, &loaded, seeds.len(), &results);
+    for line in &outcome.refused {
+        println!("  INFEASIBLE {line}");
+    }
+    println!("  {}", outcome.check_measured());
+    noise_prediction(scene, &points, &loaded, seeds.len(), &outcome.all);
     // What limits the misses: the same runs with both cells' noise at zero, and with cells a
     // user would size to the load (same noise in % FS).
     rerun(
@@ -815,11 +832,92 @@ fn envelope(scene: &Scene<'_>, seeds: &[u64], jobs: usize, out: &Path) -> Result
              {CELL_MARGIN} x the plant's natural friction, noise still in % FS)"
         ),
     );
+    let infeasible = outcome.refused.len();
     Ok(Done {
         stats,
-        results,
-        infeasible: 0,
+        results: outcome.results,
+        infeasible,
     })
+}
+
+/// The runs of a sweep split by the feasibility check: every run is run, so that the check
+/// itself is measured (a refused run that passes is a refusal the check should not have made).
+struct Feasible<'a> {
+    /// The runs the check accepts.
+    runs: Vec<Run<'a>>,
+    /// Their results, in the order of `runs`.
+    results: Vec<Result<RunSummary, String>>,
+    /// Every run's result in the sweep's order, and whether the check refused it.
+    all: Vec<(Result<RunSummary, String>, bool)>,
+    /// `label: reason` of each refused run.
+    refused: Vec<String>,
+    /// How many refused runs passed all the same.
+    refused_but_passed: usize,
+    /// Accepted runs with a warning, and how many of them passed.
+    warned: (usize, usize),
+}
+
+impl Feasible<'_> {
+    /// How the feasibility check's verdicts compare with the runs: refused, warned, clean.
+    fn check_measured(&self) -> String {
+        let passed = self.results.iter().filter(|r| is_pass(r)).count();
+        let (warned, warned_passed) = self.warned;
+        format!(
+            "the feasibility check (all runs run, to measure it): {} refused, {} of them passed \
+             all the same; {warned} accepted with a warning, {warned_passed} passed; {} accepted \
+             without one, {} passed",
+            self.refused.len(),
+            self.refused_but_passed,
+            self.runs.len() - warned,
+            passed - warned_passed
+        )
+    }
+}
+
+/// Runs every run of `runs` and splits them by the feasibility check
+/// ([`super::sweep::refusal`], what `sonolube scene --file` refuses before running).
+fn run_feasible<'a>(runs: &[Run<'a>], jobs: usize, what: &str) -> Feasible<'a> {
+    use super::sweep::Feasibility;
+    let checks: Vec<Feasibility> = runs
+        .iter()
+        .map(|r| super::sweep::feasibility(&r.scene))
+        .collect();
+    let results = run_all(runs, jobs, what);
+    let mut outcome = Feasible {
+        runs: Vec::new(),
+        results: Vec::new(),
+        all: Vec::new(),
+        refused: Vec::new(),
+        refused_but_passed: 0,
+        warned: (0, 0),
+    };
+    for ((run, check), result) in runs.iter().zip(&checks).zip(results) {
+        match check {
+            Feasibility::Accepted { warnings } => {
+                if *warnings > 0 {
+                    outcome.warned.0 += 1;
+                    outcome.warned.1 += usize::from(is_pass(&result));
+                }
+                outcome.runs.push(run.clone());
+                outcome.results.push(result.clone());
+            }
+            Feasibility::Refused(why) => {
+                let verdict = if is_pass(&result) {
+                    outcome.refused_but_passed += 1;
+                    "passed all the same"
+                } else {
+                    "failed, as refused"
+                };
+                outcome
+                    .refused
+                    .push(format!("{} ({verdict}): {why}", run.label));
+            }
+        }
+        outcome
+            .all
+            .push((result, matches!(check, Feasibility::Refused(_))));
+    }
+    outcome
 }
 
 /// Below 1 N the cells' noise, not the physics, limits the steady error: for each such load
@@ -832,7 +930,7 @@ fn noise_prediction(
     points: &[super::grid::EnvelopePoint],
     loaded: &[crate::scene_file::LoadedScene],
     seeds: usize,
-    results: &[Result<RunSummary, String>],
+    results: &[(Result<RunSummary, String>, bool)],
 ) {
     let Some(rms_index) = scene
         .criteria
@@ -877,7 +975,8 @@ fn noise_prediction(
                         learn_s,
                     ),
             );
-            for r in results[k * seeds..(k + 1) * seeds].iter().flatten() {
+            for (r, _) in &results[k * seeds..(k + 1) * seeds] {
+                let Ok(r) = r else { continue };
                 if let Some(v) = r.verdicts.get(rms_index).and_then(|v| value_of(v.measured)) {
                     measured.push(v);
                 }
@@ -904,15 +1003,28 @@ fn rerun<'a>(
     what: &str,
 ) {
     let changed: Vec<Run<'a>> = runs.iter().map(change).collect();
-    let results = run_all(&changed, jobs, &format!("envelope, {tag}"));
-    let passed = results.iter().filter(|r| is_pass(r)).count();
+    let outcome = run_feasible(&changed, jobs, &format!("envelope, {tag}"));
+    let passed = outcome.results.iter().filter(|r| is_pass(r)).count();
+    let refused = if outcome.refused.is_empty() {
+        String::new()
+    } else {
+        format!(
+            ", {} more refused by the feasibility check ({} of them passed all the same)",
+            outcome.refused.len(),
+            outcome.refused_but_passed
+        )
+    };
     println!(
-        "  the same {} runs {what}: {passed}/{} pass",
+        "  the same {} runs {what}: {passed}/{} pass{refused}",
         changed.len(),
-        changed.len()
+        outcome.runs.len()
     );
-    for line in failures(&changed, &results) {
+    println!("    {}", outcome.check_measured());
+    for line in failures(&outcome.runs, &outcome.results) {
         println!("  FAIL {tag}: {line}");
+    }
+    for line in &outcome.refused {
+        println!("  INFEASIBLE {tag}: {line}");
     }
 }
 

@@ -54,6 +54,35 @@ pub fn summary_of(scene: &Scene<'_>, calibration: CellCalibration) -> Result<Run
     Ok(sim.run())
 }
 
+/// What the feasibility check says of a scene before it runs.
+pub enum Feasibility {
+    /// Accepted, with this many warnings.
+    Accepted { warnings: usize },
+    /// Refused, with the reason.
+    Refused(String),
+}
+
+/// The feasibility check of `scene` against its controller's model, as `sonolube scene
+/// --file` applies it before running (`sonolube::scene::feasibility`); a run that cannot be
+/// built is refused with the reason.
+pub fn feasibility(scene: &Scene<'_>) -> Feasibility {
+    let selection = match crate::speed::table_rs::select_on_host(scene) {
+        Ok(selection) => selection,
+        Err(error) => return Feasibility::Refused(error),
+    };
+    let sim = match ClosedLoop::with_selection(scene, selection) {
+        Ok(sim) => sim,
+        Err(error) => return Feasibility::Refused(format!("cannot build the run: {error:?}")),
+    };
+    let check = sonolube::scene::feasibility::check(scene, sim.station().model());
+    match check.refusal() {
+        Some(refusal) => Feasibility::Refused(refusal.to_string()),
+        None => Feasibility::Accepted {
+            warnings: check.warnings().count(),
+        },
+    }
+}
+
 /// Threads a sweep uses: every core, or `SONOLUBE_JOBS` when set to a positive number.
 pub fn threads() -> usize {
     std::env::var("SONOLUBE_JOBS")
