@@ -91,7 +91,7 @@ fn a_quality_factor_too_high_for_the_lead_is_named_with_its_limit() {
 }
 
 #[test]
-fn a_control_rate_too_low_for_the_gains_is_named() {
+fn a_control_rate_below_the_measured_range_is_named_with_why() {
     let (code, stderr) = run(&variant_of_reference(
         "slow",
         &[("name", "\"slow\""), ("control_rate_hz", "1000.0")],
@@ -102,9 +102,15 @@ fn a_control_rate_too_low_for_the_gains_is_named() {
         &[
             "control_rate_hz",
             "1000 is outside 6000 ..= 100000",
-            "integral gain 6000 /s",
+            "below 6000 Hz the loop has not been shown to hold",
         ],
     );
+    let (code, stderr) = run(&variant_of_reference(
+        "fast",
+        &[("name", "\"fast\""), ("control_rate_hz", "200000.0")],
+    ));
+    assert_eq!(code, 1, "{stderr}");
+    assert_words(&stderr, &["200000 is outside", "6e6 control steps"]);
 }
 
 #[test]

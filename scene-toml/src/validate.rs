@@ -82,10 +82,21 @@ pub(crate) fn scene(raw: RawScene, errors: Errors<'_>) -> Result<SceneDescriptio
             CONTROL_RATE_RANGE_HZ.1,
         )
         .map_err(|error| SceneError {
-            reason: format!(
-                "{}: the controller's fast integral gain {} /s needs ki T <= 1",
-                error.reason, CONTROL_RATE_RANGE_HZ.0
-            ),
+            reason: if raw
+                .control_rate_hz
+                .is_some_and(|r| r > CONTROL_RATE_RANGE_HZ.1)
+            {
+                format!(
+                    "{}: a 60 s run must stay within 6e6 control steps",
+                    error.reason
+                )
+            } else {
+                format!(
+                    "{}: below {} Hz the loop has not been shown to hold a scene's criteria \
+                     (each period adds to the lag the model error is seen through)",
+                    error.reason, CONTROL_RATE_RANGE_HZ.0
+                )
+            },
             ..error
         })?;
     let duration_s = errors.positive("duration_s", raw.duration_s, 60.0)?;

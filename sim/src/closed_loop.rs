@@ -343,6 +343,12 @@ impl<'a> ClosedLoop<'a> {
             step: readings.step,
             time_s: truth.time_s,
             judged,
+            friction_n: truth.target.map(|target| {
+                (
+                    target_friction_n(&target, truth),
+                    libm::fabsf(truth.contact.friction_n),
+                )
+            }),
             target_step,
             at_limit,
             load_ramping: ramping(self.scene.normal_load_n, truth.time_s),

@@ -91,6 +91,36 @@ enum Track {
     Faults,
 }
 
+/// The overshoot of a target step that changes the target's kind (a reduction to a
+/// coefficient, say), in newtons of friction: the step is the change of the friction the
+/// targets ask of the plant, the excursion the plant's friction past the new target in the
+/// step's direction.
+#[derive(Debug, Clone, Copy)]
+struct CrossStep {
+    /// Target friction after the step minus before it, N.
+    step_n: f32,
+    /// Largest excursion past the target in the step's direction so far, N (>= 0).
+    worst_past_n: f32,
+}
+
+impl CrossStep {
+    fn add(&mut self, (target_n, actual_n): (f32, f32)) {
+        let past = (actual_n - target_n) * libm::copysignf(1.0, self.step_n);
+        if past > self.worst_past_n {
+            self.worst_past_n = past;
+        }
+    }
+
+    /// In percent of the step (0 for a step of no size).
+    fn overshoot_pct(&self) -> f32 {
+        if self.step_n != 0.0 {
+            100.0 * self.worst_past_n / libm::fabsf(self.step_n)
+        } else {
+            0.0
+        }
+    }
+}
+
 /// The online judge of one run.
 #[derive(Debug, Clone)]
 pub struct Judge {
@@ -99,6 +129,10 @@ pub struct Judge {
     segments: Vec<StepSegment, MAX_SEGMENTS>,
     current: Option<(Origin, Quantity, bool)>,
     last: Option<(Quantity, f32)>,
+    /// The target friction at the last step, N.
+    last_friction_target_n: Option<f32>,
+    /// The current segment's overshoot in newtons, when its step changed the target's kind.
+    cross: Option<CrossStep>,
     criteria: Vec<(Criterion, Track), MAX_CRITERIA>,
     faults: Vec<FaultReaction, MAX_FAULTS>,
     at_limit_steps: u32,
@@ -166,6 +200,8 @@ impl Judge {
             segments: Vec::new(),
             current: None,
             last: None,
+            last_friction_target_n: None,
+            cross: None,
             criteria,
             faults,
             at_limit_steps: 0,
@@ -225,8 +261,24 @@ impl Judge {
         }
         if new_segment {
             self.current = Some((origin, judged.quantity, same_quantity));
+            self.cross = match (
+                origin,
+                same_quantity,
+                self.last_friction_target_n,
+                o.friction_n,
+            ) {
+                (Origin::Step, false, Some(before), Some((after, _))) => Some(CrossStep {
+                    step_n: after - before,
+                    worst_past_n: 0.0,
+                }),
+                _ => None,
+            };
+        }
+        if let (Some(cross), Some(friction)) = (&mut self.cross, o.friction_n) {
+            cross.add(friction);
         }
         self.last = Some((judged.quantity, judged.target));
+        self.last_friction_target_n = o.friction_n.map(|(target, _)| target);
     }
 
     fn close(&mut self, mut metrics: SegmentMetrics, current: Option<(Origin, Quantity, bool)>) {
@@ -235,7 +287,12 @@ impl Judge {
         };
         // `Metrics` counts from the first observation, whose sample is at one period.
         metrics.start_s += self.period_s;
-        if origin == Origin::Step && same_quantity {
+        // A step between two kinds of target: its size and excursion in newtons of friction.
+        let cross = if same_quantity { None } else { self.cross };
+        if let Some(cross) = cross {
+            metrics.overshoot_pct = cross.overshoot_pct();
+        }
+        if origin == Origin::Step && (same_quantity || cross.is_some()) {
             for (_, track) in &mut self.criteria {
                 if let Track::Overshoot { judged, worst_pct } = track {
                     *judged += 1;

@@ -14,6 +14,9 @@ fn scene_with<'a>(criteria: &'a [Criterion], faults: &'a [FaultEvent]) -> Scene<
     }
 }
 
+/// The natural friction of the hand-made observations, N: a ratio target `r` asks for `r` x it.
+const NATURAL_N: f32 = 2.0;
+
 fn observe(judge: &mut Judge, step: u32, target: f32, actual: f32, target_step: bool) {
     judge.observe(&Observation {
         step,
@@ -23,6 +26,7 @@ fn observe(judge: &mut Judge, step: u32, target: f32, actual: f32, target_step: 
             target,
             actual,
         }),
+        friction_n: Some((target * NATURAL_N, actual * NATURAL_N)),
         target_step,
         at_limit: false,
         load_ramping: false,
@@ -72,6 +76,46 @@ fn a_step_is_judged_for_settling_and_overshoot() {
     assert!(matches!(v[2].measured, Measured::Seconds(s) if (s - 0.0003).abs() < 1e-7));
     assert!(v[2].passed);
     assert!(!summary.passed());
+}
+
+#[test]
+fn a_step_to_another_kind_of_target_is_judged_for_overshoot_in_newtons() {
+    let scene = scene_with(&STEP_CRITERIA, &[]);
+    let mut judge = Judge::new(&scene).expect("fits");
+    // Natural friction held (ratio 1, 2 N at a 4 N load), then a coefficient target of 0.25
+    // (1 N): a 1 N step down. The friction dips to 0.94 N, 6 % of the step past the target.
+    for step in 1..=10 {
+        observe(&mut judge, step, 1.0, 1.0, false);
+    }
+    let load_n = 4.0;
+    let response = [2.0, 1.5, 1.1, 0.94, 0.97, 1.0, 1.0, 1.005, 1.0, 1.0];
+    for (k, actual_n) in response.iter().enumerate() {
+        judge.observe(&Observation {
+            step: 11 + k as u32,
+            time_s: (11 + k) as f32 * PERIOD_S,
+            judged: Some(Judged {
+                quantity: Quantity::Coefficient,
+                target: 0.25,
+                actual: actual_n / load_n,
+            }),
+            friction_n: Some((1.0, *actual_n)),
+            target_step: k == 0,
+            at_limit: false,
+            load_ramping: false,
+            state: SupervisorState::Running,
+            drive_zero: false,
+        });
+    }
+    let summary = judge.summary();
+    let step = summary.segments[1];
+    assert!(!step.same_quantity);
+    assert!((step.metrics.overshoot_pct - 6.0).abs() < 1e-3, "{step:?}");
+    assert!(
+        matches!(summary.verdicts[1].measured, Measured::Percent(p) if (p - 6.0).abs() < 1e-3),
+        "{:?}",
+        summary.verdicts[1]
+    );
+    assert!(!summary.verdicts[1].passed);
 }
 
 #[test]
@@ -181,6 +225,7 @@ fn a_fault_is_timed_from_its_onset_sample_to_fault_with_zero_drive() {
                 step,
                 time_s: step as f32 * PERIOD_S,
                 judged: None,
+                friction_n: None,
                 target_step: false,
                 at_limit: false,
                 load_ramping: false,

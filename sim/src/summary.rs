@@ -18,6 +18,10 @@ pub struct Observation {
     pub time_s: f32,
     /// The target and the plant's value in its quantity; `None` without a target.
     pub judged: Option<Judged>,
+    /// The friction force the target asks of the plant and the plant's true friction, N
+    /// (magnitudes); `None` without a target. The one quantity every target shares: a step
+    /// that changes the target's kind is judged for overshoot in it.
+    pub friction_n: Option<(f32, f32)>,
     /// A target step (not a ramp, not the first point) takes effect at this step.
     pub target_step: bool,
     /// The drive command is at the actuator's ceiling.
@@ -52,8 +56,10 @@ pub struct StepSegment {
     pub origin: Origin,
     /// The quantity its target and errors are in.
     pub quantity: Quantity,
-    /// Whether the previous target was of the same quantity (else the step size and the
-    /// overshoot compare different quantities and are not judged).
+    /// Whether the previous target was of the same quantity. When it was not, the segment's
+    /// `overshoot_pct` is measured in newtons of friction (the target friction before and
+    /// after the step, and the plant's friction against the new target): the one quantity
+    /// both targets share.
     pub same_quantity: bool,
 }
 

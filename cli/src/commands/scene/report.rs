@@ -123,6 +123,9 @@ pub(super) fn report(
         };
         let overshoot = if segment.origin == Origin::Step && segment.same_quantity {
             format!("{:.2} %", m.overshoot_pct)
+        } else if segment.origin == Origin::Step {
+            // Measured in newtons of friction across the change of the target's kind.
+            format!("{:.2} % (N)", m.overshoot_pct)
         } else {
             String::from("-")
         };
