@@ -54,6 +54,9 @@ pub enum SceneRefusal {
     Drive(DriveRefusal),
     /// The board's load-cell calibration ([`config::LOAD_CELL_INTERNAL`]) is unusable.
     Cells(SenseError),
+    /// The scene is not one this build compiled in, so its model variant selection is not in
+    /// flash ([`sonolube::scene::builtin::selection`]); the board does not link the selection.
+    NotCompiled,
 }
 
 /// Everything that depends on the scene, built whole before it replaces the running one.
@@ -81,8 +84,18 @@ impl Setup {
         .map_err(SceneRefusal::Drive)?;
         let hold = hold_steps(scene.control_rate_hz);
         let channel = cell_channel(calibration, hold);
-        let mut station = Station::new(scene, &controller_settings(scene), channel, channel)
-            .map_err(SceneRefusal::Station)?;
+        // The selection the build script made (the one `Station::new` would make, tested in
+        // `scene::builtin`): the selection code and the measured table stay out of flash.
+        let selection =
+            sonolube::scene::builtin::selection(scene).ok_or(SceneRefusal::NotCompiled)?;
+        let mut station = Station::with_selection(
+            scene,
+            &controller_settings(scene),
+            selection,
+            channel,
+            channel,
+        )
+        .map_err(SceneRefusal::Station)?;
         if current::running() {
             // ADC2 samples the drive current at the stepped phases: `freq auto` can run.
             station.enable_current_sense();
