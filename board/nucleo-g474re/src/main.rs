@@ -39,6 +39,7 @@ mod ext_adc;
 mod overcurrent;
 mod rig;
 mod safe;
+mod scene_start;
 mod sense_task;
 mod sensing;
 mod settings_flash;
