@@ -16,8 +16,9 @@ use sonolube::{model::ModelError::*, protocol::Target::*};
 pub struct SceneStart {
     /// The scene's name.
     pub name: &'static str,
-    /// `sonolube::control::controller_settings` of the scene.
-    pub settings: Settings,
+    /// `sonolube::control::controller_settings` of the scene (shared by the scenes whose
+    /// settings are the same).
+    pub settings: &'static Settings,
     /// `sonolube::scene::feasibility::check` of the scene on its selected model: every finding,
     /// warnings and refusals (none for the shipped scenes today).
     pub findings: &'static [Finding],
