@@ -92,7 +92,7 @@ impl Setup {
         // The settings the build script computed (`controller_settings`, scene_start.rs).
         let start = scene_start::of(scene).ok_or(SceneRefusal::NotCompiled)?;
         let mut station =
-            Station::with_selection(scene, &start.settings, selection, channel, channel)
+            Station::with_selection(scene, start.settings, selection, channel, channel)
                 .map_err(SceneRefusal::Station)?;
         if current::running() {
             // ADC2 samples the drive current at the stepped phases: `freq auto` can run.
