@@ -35,6 +35,7 @@ mod config;
 mod console;
 mod current;
 mod drive;
+mod drive_fit;
 mod ext_adc;
 mod overcurrent;
 mod rig;
