@@ -36,7 +36,8 @@ impl SceneStart {
 include!(concat!(env!("OUT_DIR"), "/scene_start.rs"));
 
 /// The scene-start constants of the built-in scene `scene` (every scene the board can select
-/// is one: `sonolube::scene::builtin::find`).
+/// is one: `sonolube::scene::builtin::find`); `None` as well for a scene whose drive the bridge
+/// refuses ([`crate::drive_fit`]), which `rig::Setup::new` refuses before it asks.
 pub fn of(scene: &Scene<'_>) -> Option<&'static SceneStart> {
     SCENE_START.iter().find(|start| start.name == scene.name)
 }
