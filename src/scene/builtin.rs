@@ -15,6 +15,7 @@ use crate::protocol::Target;
 
 include!(concat!(env!("OUT_DIR"), "/scenes.rs"));
 include!(concat!(env!("OUT_DIR"), "/cube_tables.rs"));
+include!(concat!(env!("OUT_DIR"), "/selections.rs"));
 
 /// Every built-in scene ([`SCENES`]).
 pub fn compiled() -> &'static [Scene<'static>] {
@@ -36,6 +37,16 @@ pub fn cube_table_nodes(scene: &Scene<'_>, variant: &str) -> Option<&'static [i3
         .iter()
         .find(|(name, table, _)| *name == scene.name && *table == variant)?;
     (find(scene.name)? == scene).then_some(*nodes)
+}
+
+/// The model variant selection of `scene` ([`crate::variant::select`]) that the build script
+/// made for it (`build.rs`: every compiled scene's, from the same measured table), if `scene`
+/// is that compiled scene in every value. A firmware that runs only its built-in scenes (the
+/// G474) takes its selections from here and links neither the selection nor the measured
+/// table; a test checks that each is the one `select` makes.
+pub fn selection(scene: &Scene<'_>) -> Option<crate::variant::Selection> {
+    let (_, selection) = SELECTIONS.iter().find(|(name, _)| *name == scene.name)?;
+    (find(scene.name)? == scene).then_some(*selection)
 }
 
 #[cfg(test)]
@@ -64,6 +75,24 @@ mod tests {
             );
         }
         assert!(find("no-such-scene").is_none());
+    }
+
+    /// The selections the build script put in flash are `select`'s, field for field (floats
+    /// bit for bit: `PartialEq` on the `f32`s, none of which is NaN), for every compiled scene,
+    /// and a copy of a scene that differs from it (loaded at run time) gets none.
+    #[test]
+    fn the_selections_in_flash_are_the_runtime_ones() {
+        use crate::variant::select;
+        assert_eq!(SELECTIONS.len(), SCENES.len());
+        for scene in SCENES {
+            let made = select(scene);
+            assert_eq!(selection(scene), Some(made), "{}", scene.name);
+            let copy = Scene {
+                description: "a copy loaded at run time",
+                ..*scene
+            };
+            assert_eq!(selection(&copy), None, "{}", scene.name);
+        }
     }
 
     #[test]

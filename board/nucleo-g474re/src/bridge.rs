@@ -29,7 +29,9 @@ use sonolube::drive::{Amplitude, DriveError, DriveLimits, DriveTiming, Frequency
 use sonolube::fx::{Q1_31, Q2_30};
 use sonolube::protocol::SupervisorState;
 
-use crate::{config, drive, safe};
+pub use crate::drive_fit::DriveRefusal;
+use crate::drive_fit::drive_fit;
+use crate::{drive, safe};
 
 /// Whether the control loop drives the bridge: not in the bring-up build.
 pub const CONTROLS_BRIDGE: bool = cfg!(not(feature = "bringup"));
@@ -44,25 +46,6 @@ pub enum Stopped {
     /// MOE dropped with neither of the above (the sensing task cleared it on a faulty current
     /// sample that has since recovered).
     OutputsDropped,
-}
-
-/// Why a scene's drive cannot run on this board.
-#[derive(Debug, Clone, Copy, PartialEq, defmt::Format)]
-pub enum DriveRefusal {
-    /// The scene's drive frequency is outside the stack's 20-60 kHz band.
-    FrequencyOutOfBand {
-        /// The scene's drive frequency, mHz.
-        millihertz: u32,
-    },
-    /// The scene's full-scale stack voltage exceeds the bridge's full-scale fundamental.
-    FullScaleVoltage {
-        /// The scene's, V.
-        scene_v: f64,
-        /// The bridge's, V.
-        bridge_v: f64,
-    },
-    /// TIM1 cannot make the timing, or the stack ratings are unusable.
-    Drive(DriveError),
 }
 
 /// The bridge settings of one scene and whether the control loop has switched it on.
@@ -84,31 +67,13 @@ impl Bridge {
     /// The bridge for a scene whose drive runs at `drive_hz` with `full_scale_voltage_v` on the
     /// stack at full command. Configuration (`f64`), once per scene; writes nothing.
     pub fn for_scene(drive_hz: f64, full_scale_voltage_v: f64) -> Result<Self, DriveRefusal> {
-        // `as` saturates (and maps NaN to 0), which the band check then refuses.
-        let frequency = Frequency::from_millihertz((drive_hz * 1000.0 + 0.5) as u32);
-        if !frequency.in_band() {
-            return Err(DriveRefusal::FrequencyOutOfBand {
-                millihertz: frequency.millihertz(),
-            });
-        }
-        let ratio = full_scale_voltage_v / config::FULL_SCALE_V;
-        if !(ratio > 0.0 && ratio <= 1.0) {
-            return Err(DriveRefusal::FullScaleVoltage {
-                scene_v: full_scale_voltage_v,
-                bridge_v: config::FULL_SCALE_V,
-            });
-        }
-        let timing = config::TIMING
-            .retune(frequency)
-            .map_err(DriveRefusal::Drive)?;
-        let limits =
-            DriveLimits::new(&config::STACK, config::FULL_SCALE_V).map_err(DriveRefusal::Drive)?;
+        let fit = drive_fit(drive_hz, full_scale_voltage_v)?;
         Ok(Self {
-            timing,
-            limits,
+            timing: fit.timing,
+            limits: fit.limits,
             // ratio in (0, 1]: at most 2^30.
-            scale_q30: (ratio * (1u64 << 30) as f64 + 0.5) as i64,
-            ceiling: limits.max_amplitude(frequency),
+            scale_q30: (fit.ratio * (1u64 << 30) as f64 + 0.5) as i64,
+            ceiling: fit.limits.max_amplitude(fit.frequency),
             amplitude: Amplitude::ZERO,
             on: false,
         })

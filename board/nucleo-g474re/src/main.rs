@@ -35,10 +35,12 @@ mod config;
 mod console;
 mod current;
 mod drive;
+mod drive_fit;
 mod ext_adc;
 mod overcurrent;
 mod rig;
 mod safe;
+mod scene_start;
 mod sense_task;
 mod sensing;
 mod settings_flash;
@@ -217,11 +219,11 @@ async fn control_task(settings: Settings) {
         Err((name, refusal)) => {
             // The drive stays safe; the watchdog (started without steps) resets the board.
             // A scene refused for its control period: the selection line says by how much.
-            if let Some(scene) = sonolube::scene::builtin::find(name) {
-                let selection = sonolube::variant::select(scene);
-                if selection.refused() {
-                    defmt::error!("scene {=str}: controller {}", name, selection);
-                }
+            if let Some(selection) =
+                sonolube::scene::builtin::find(name).and_then(sonolube::scene::builtin::selection)
+                && selection.refused()
+            {
+                defmt::error!("scene {=str}: controller {}", name, selection);
             }
             defmt::error!("scene {=str} cannot run on this board: {}", name, refusal);
             return;

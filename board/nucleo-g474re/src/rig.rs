@@ -6,7 +6,8 @@
 //! output goes to the bridge ([`crate::bridge`]). The station's channels are the board's own
 //! ([`cell_channel`]: the internal ADC's format, the board's fault limits, the cells' datasheet
 //! calibration, then `tare` and `cal`); the controller runs the core's tuning for the scene
-//! ([`sonolube::control::controller_settings`]), whose plausible force ranges are the scene
+//! ([`sonolube::control::controller_settings`], computed by the build script: [`crate::scene_start`]),
+//! whose plausible force ranges are the scene
 //! cells' (1.1 x their full scale): a force beyond it is a sensor fault, drive safe. This is
 //! the QEMU board's rig with hardware where the simulated plant was.
 //!
@@ -26,7 +27,7 @@
 use core::fmt::Write as _;
 
 use cortex_m::peripheral::DWT;
-use sonolube::control::{ExternalFault, Reason, controller_settings};
+use sonolube::control::{ExternalFault, Reason};
 use sonolube::drive::Frequency;
 use sonolube::protocol::{Axis, Command, DRIVE_FREQ, ProtocolError, SupervisorState, TokenText};
 use sonolube::resonance::LockState;
@@ -40,7 +41,7 @@ use crate::bridge::{Bridge, CONTROLS_BRIDGE, DriveRefusal};
 use crate::cells::{CellFeed, RawPair};
 use crate::current::RingReader;
 use crate::sensing::TRIGGERS_PER_TRIPLET;
-use crate::{config, current, drive};
+use crate::{config, current, drive, scene_start};
 
 /// A pair held for more than this many times the longest expected hold is stale.
 pub const STALE_HOLDS: u32 = 8;
@@ -54,6 +55,9 @@ pub enum SceneRefusal {
     Drive(DriveRefusal),
     /// The board's load-cell calibration ([`config::LOAD_CELL_INTERNAL`]) is unusable.
     Cells(SenseError),
+    /// The scene is not one this build compiled in, so its model variant selection is not in
+    /// flash ([`sonolube::scene::builtin::selection`]); the board does not link the selection.
+    NotCompiled,
 }
 
 /// Everything that depends on the scene, built whole before it replaces the running one.
@@ -81,8 +85,15 @@ impl Setup {
         .map_err(SceneRefusal::Drive)?;
         let hold = hold_steps(scene.control_rate_hz);
         let channel = cell_channel(calibration, hold);
-        let mut station = Station::new(scene, &controller_settings(scene), channel, channel)
-            .map_err(SceneRefusal::Station)?;
+        // The selection the build script made (the one `Station::new` would make, tested in
+        // `scene::builtin`): the selection code and the measured table stay out of flash.
+        let selection =
+            sonolube::scene::builtin::selection(scene).ok_or(SceneRefusal::NotCompiled)?;
+        // The settings the build script computed (`controller_settings`, scene_start.rs).
+        let start = scene_start::of(scene).ok_or(SceneRefusal::NotCompiled)?;
+        let mut station =
+            Station::with_selection(scene, start.settings, selection, channel, channel)
+                .map_err(SceneRefusal::Station)?;
         if current::running() {
             // ADC2 samples the drive current at the stepped phases: `freq auto` can run.
             station.enable_current_sense();
@@ -197,12 +208,15 @@ impl BoardRig {
         };
         match Setup::new(scene) {
             Ok(setup) => {
-                // What cannot work is refused before it runs (issue 26).
-                let feasibility = setup.station.feasibility(scene);
-                for finding in feasibility.findings() {
+                // What cannot work is refused before it runs (issue 26): the findings of
+                // `Station::feasibility`, computed by the build script (scene_start.rs).
+                let Some(start) = scene_start::of(scene) else {
+                    return Err(ProtocolError::UnknownScene { name });
+                };
+                for finding in start.findings {
                     defmt::warn!("scene {=str}: {}", scene.name, finding);
                 }
-                if let Some(refusal) = feasibility.refusal() {
+                if let Some(refusal) = start.refusal() {
                     return Err(ProtocolError::Unavailable {
                         command: command.keyword(),
                         reason: refusal.summary(),

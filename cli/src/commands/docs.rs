@@ -181,6 +181,26 @@ pub const BLOCKS: &[Block] = &[
         },
     },
     Block {
+        name: "g474-flash-top",
+        run: "board/nucleo-g474re/scripts/flash-top 25",
+        show: None,
+        fence: true,
+        cost: Cost::Slow {
+            why: "a release cross-build of the G474 firmware",
+            fresh: &[],
+        },
+    },
+    Block {
+        name: "g474-scenes",
+        run: "board/nucleo-g474re/scripts/scene-list",
+        show: None,
+        fence: true,
+        cost: Cost::Slow {
+            why: "a release cross-build of the G474 firmware",
+            fresh: &[],
+        },
+    },
+    Block {
         name: "qemu-horn-scenes",
         run: "cargo build --quiet --release --target thumbv7em-none-eabihf -p sonolube-qemu && for s in load-ramp horn-al-ss horn-ss-ss; do scripts/qemu-run target/thumbv7em-none-eabihf/release/sonolube-qemu scene=$s 2>&1; done",
         show: Some(
