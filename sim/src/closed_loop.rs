@@ -31,6 +31,7 @@ use sonolube::fx::Q1_31;
 use sonolube::model::AnyModel;
 use sonolube::protocol::{Axis, Command, ProtocolError, SupervisorState, Target, TargetRange};
 use sonolube::scene::{Breakpoint, Scene};
+use sonolube::stage::{Stage, StageMarks};
 use sonolube::station::{CellBench, Sample, Station};
 
 /// One control step of a run, for plots, CSV files and checks.
@@ -296,6 +297,13 @@ impl<'a> ClosedLoop<'a> {
     /// output (its `amplitude` is the command for the next period). `None` unless a plant
     /// phase is due for control.
     pub fn control_phase(&mut self) -> Option<Output> {
+        self.control_phase_marked(&mut ())
+    }
+
+    /// Phase 2 with its stages marked in `marks` (the benchmark's breakdown of a control
+    /// step's cost, `sonolube::stage`); the same computation whatever the marks.
+    pub fn control_phase_marked(&mut self, marks: &mut impl StageMarks) -> Option<Output> {
+        marks.enter(Stage::Script);
         let Phase::Control(readings) = self.phase else {
             return None;
         };
@@ -312,16 +320,21 @@ impl<'a> ClosedLoop<'a> {
             // interpolates between two of them: the command is accepted.
             let _ = self.station.controller_mut().set_target(target);
         }
+        marks.enter(Stage::Resonance);
         let count = usize::from(readings.current_count);
         if count > 0 {
             self.station
                 .push_current(readings.current_codes.get(..count).unwrap_or(&[]));
         }
-        let control = self.station.control(&Sample {
-            normal_code: readings.normal_code,
-            tangential_code: readings.tangential_code,
-            sliding_velocity_m_per_s: readings.sliding_velocity_m_per_s,
-        });
+        let control = self.station.control_marked(
+            &Sample {
+                normal_code: readings.normal_code,
+                tangential_code: readings.tangential_code,
+                sliding_velocity_m_per_s: readings.sliding_velocity_m_per_s,
+            },
+            marks,
+        );
+        marks.enter(Stage::Script);
         let output = control.output;
         self.command = output.amplitude.to_f32();
         self.phase = Phase::Finish(readings, output, control.sensor_fault, target_step);

@@ -23,15 +23,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Littmann closed form f32 micromath",
-        instructions: 33.891,
+        instructions: 33.872,
     },
     Cost {
         variant: "Littmann closed form f32 libm",
-        instructions: 417.807,
+        instructions: 417.826,
     },
     Cost {
         variant: "Littmann closed form f64",
-        instructions: 3356.055,
+        instructions: 3355.978,
     },
     Cost {
         variant: "Dahl update",
@@ -39,23 +39,23 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl update f32 micromath",
-        instructions: 107.111,
+        instructions: 107.282,
     },
     Cost {
         variant: "Dahl update f32 libm",
-        instructions: 61.641,
+        instructions: 61.572,
     },
     Cost {
         variant: "Dahl update f64",
-        instructions: 2228.17,
+        instructions: 2228.102,
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 296.372,
+        instructions: 296.225,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 68.627,
+        instructions: 68.676,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
@@ -63,51 +63,51 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Coulomb ratio f64",
-        instructions: 2720.147,
+        instructions: 2719.901,
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11363.655,
+        instructions: 11363.548,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 5869.623,
+        instructions: 5869.462,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 31846.074,
+        instructions: 31846.396,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 147230.16,
+        instructions: 147229.89,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20291.506,
+        instructions: 20291.129,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
-        instructions: 11294.408,
+        instructions: 11294.516,
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 58658.816,
+        instructions: 58659.086,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 269835.0,
+        instructions: 269834.2,
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 38005.914,
+        instructions: 38005.97,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22176.182,
+        instructions: 22175.967,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 111925.43,
+        instructions: 111924.68,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
@@ -115,115 +115,115 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady T=49x73",
-        instructions: 322.096,
+        instructions: 322.526,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 590.961,
+        instructions: 591.089,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
-        instructions: 377.82,
+        instructions: 378.012,
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 263.076,
+        instructions: 263.012,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9437.756,
+        instructions: 9437.692,
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 829.038,
-    },
-    Cost {
-        variant: "cube el N=8 f32 micromath",
-        instructions: 631.987,
-    },
-    Cost {
-        variant: "cube el N=8 f32 libm",
-        instructions: 393.397,
-    },
-    Cost {
-        variant: "cube el N=8 f64",
-        instructions: 15243.653,
-    },
-    Cost {
-        variant: "cube el N=16",
-        instructions: 1304.807,
-    },
-    Cost {
-        variant: "cube el N=16 f32 micromath",
-        instructions: 1141.858,
-    },
-    Cost {
-        variant: "cube el N=16 f32 libm",
-        instructions: 657.628,
-    },
-    Cost {
-        variant: "cube el N=16 f64",
-        instructions: 26895.896,
-    },
-    Cost {
-        variant: "cube el N=32",
-        instructions: 2257.051,
-    },
-    Cost {
-        variant: "cube el N=32 f32 micromath",
-        instructions: 2161.987,
-    },
-    Cost {
-        variant: "cube el N=32 f32 libm",
-        instructions: 1183.846,
-    },
-    Cost {
-        variant: "cube el N=32 f64",
-        instructions: 50148.59,
-    },
-    Cost {
-        variant: "cube el T=5x5",
-        instructions: 282.82,
-    },
-    Cost {
-        variant: "cube el T=9x9",
-        instructions: 282.756,
-    },
-    Cost {
-        variant: "cube el T=17x17",
-        instructions: 282.756,
-    },
-    Cost {
-        variant: "cube ep N=4",
-        instructions: 590.833,
-    },
-    Cost {
-        variant: "cube ep N=4 f32 micromath",
-        instructions: 378.076,
-    },
-    Cost {
-        variant: "cube ep N=4 f32 libm",
-        instructions: 263.076,
-    },
-    Cost {
-        variant: "cube ep N=4 f64",
-        instructions: 9428.653,
-    },
-    Cost {
-        variant: "cube ep N=8",
         instructions: 828.974,
     },
     Cost {
-        variant: "cube ep N=8 f32 micromath",
+        variant: "cube el N=8 f32 micromath",
         instructions: 631.794,
     },
     Cost {
+        variant: "cube el N=8 f32 libm",
+        instructions: 393.461,
+    },
+    Cost {
+        variant: "cube el N=8 f64",
+        instructions: 15243.525,
+    },
+    Cost {
+        variant: "cube el N=16",
+        instructions: 1305.0,
+    },
+    Cost {
+        variant: "cube el N=16 f32 micromath",
+        instructions: 1141.987,
+    },
+    Cost {
+        variant: "cube el N=16 f32 libm",
+        instructions: 657.692,
+    },
+    Cost {
+        variant: "cube el N=16 f64",
+        instructions: 26896.152,
+    },
+    Cost {
+        variant: "cube el N=32",
+        instructions: 2256.923,
+    },
+    Cost {
+        variant: "cube el N=32 f32 micromath",
+        instructions: 2161.923,
+    },
+    Cost {
+        variant: "cube el N=32 f32 libm",
+        instructions: 1183.717,
+    },
+    Cost {
+        variant: "cube el N=32 f64",
+        instructions: 50148.203,
+    },
+    Cost {
+        variant: "cube el T=5x5",
+        instructions: 282.884,
+    },
+    Cost {
+        variant: "cube el T=9x9",
+        instructions: 282.692,
+    },
+    Cost {
+        variant: "cube el T=17x17",
+        instructions: 282.628,
+    },
+    Cost {
+        variant: "cube ep N=4",
+        instructions: 591.025,
+    },
+    Cost {
+        variant: "cube ep N=4 f32 micromath",
+        instructions: 378.012,
+    },
+    Cost {
+        variant: "cube ep N=4 f32 libm",
+        instructions: 263.012,
+    },
+    Cost {
+        variant: "cube ep N=4 f64",
+        instructions: 9428.717,
+    },
+    Cost {
+        variant: "cube ep N=8",
+        instructions: 828.91,
+    },
+    Cost {
+        variant: "cube ep N=8 f32 micromath",
+        instructions: 632.051,
+    },
+    Cost {
         variant: "cube ep N=8 f32 libm",
-        instructions: 393.653,
+        instructions: 393.589,
     },
     Cost {
         variant: "cube ep N=8 f64",
-        instructions: 15231.346,
+        instructions: 15231.602,
     },
     Cost {
         variant: "cube ep N=16",
@@ -231,43 +231,43 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
-        instructions: 1141.987,
+        instructions: 1141.858,
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 657.628,
+        instructions: 657.692,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26885.77,
+        instructions: 26885.705,
     },
     Cost {
         variant: "cube ep N=32",
-        instructions: 2256.858,
+        instructions: 2257.051,
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
-        instructions: 2161.858,
+        instructions: 2161.923,
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
-        instructions: 1183.91,
+        instructions: 1183.974,
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50137.242,
+        instructions: 50137.31,
     },
     Cost {
         variant: "cube ep T=5x5",
-        instructions: 282.884,
+        instructions: 282.692,
     },
     Cost {
         variant: "cube ep T=9x9",
-        instructions: 282.756,
+        instructions: 282.82,
     },
     Cost {
         variant: "cube ep T=17x17",
-        instructions: 282.628,
+        instructions: 282.82,
     },
 ];
 
@@ -1253,97 +1253,97 @@ static ERRORS: &[SceneError] = &[
 static STEPS: &[StepCost] = &[
     StepCost {
         variant: "Coulomb ratio",
-        mean: 3229.92,
+        mean: 3225.44,
         longest: 3520,
     },
     StepCost {
         variant: "Dahl steady N=16",
-        mean: 210488.64,
+        mean: 210488.8,
         longest: 262440,
     },
     StepCost {
         variant: "Dahl steady N=32",
-        mean: 380549.6,
-        longest: 474200,
+        mean: 380543.53,
+        longest: 474160,
     },
     StepCost {
         variant: "Dahl steady N=64",
-        mean: 715512.6,
-        longest: 892200,
+        mean: 715539.06,
+        longest: 892120,
     },
     StepCost {
         variant: "Dahl steady T=49x73",
-        mean: 3882.08,
+        mean: 3879.2,
         longest: 4520,
     },
     StepCost {
         variant: "cube el N=4",
-        mean: 4717.156,
+        mean: 4719.123,
         longest: 6280,
     },
     StepCost {
         variant: "cube el N=8",
-        mean: 5706.974,
-        longest: 7760,
+        mean: 5708.163,
+        longest: 7800,
     },
     StepCost {
         variant: "cube el N=16",
-        mean: 7684.036,
+        mean: 7686.567,
         longest: 10800,
     },
     StepCost {
         variant: "cube el N=32",
-        mean: 11640.516,
+        mean: 11642.985,
         longest: 16880,
     },
     StepCost {
         variant: "cube el T=5x5",
-        mean: 3745.185,
-        longest: 3880,
+        mean: 3745.738,
+        longest: 3840,
     },
     StepCost {
         variant: "cube el T=9x9",
-        mean: 3771.243,
+        mean: 3771.883,
         longest: 3880,
     },
     StepCost {
         variant: "cube el T=17x17",
-        mean: 3779.745,
-        longest: 3880,
+        mean: 3780.796,
+        longest: 3960,
     },
     StepCost {
         variant: "cube ep N=4",
-        mean: 4719.68,
+        mean: 4719.418,
         longest: 6240,
     },
     StepCost {
         variant: "cube ep N=8",
-        mean: 5706.927,
-        longest: 7760,
+        mean: 5710.243,
+        longest: 7800,
     },
     StepCost {
         variant: "cube ep N=16",
-        mean: 7685.84,
+        mean: 7688.858,
         longest: 10800,
     },
     StepCost {
         variant: "cube ep N=32",
-        mean: 11645.072,
-        longest: 16880,
+        mean: 11645.236,
+        longest: 16920,
     },
     StepCost {
         variant: "cube ep T=5x5",
-        mean: 3745.709,
+        mean: 3746.363,
         longest: 3880,
     },
     StepCost {
         variant: "cube ep T=9x9",
-        mean: 3771.41,
+        mean: 3773.003,
         longest: 3880,
     },
     StepCost {
         variant: "cube ep T=17x17",
-        mean: 3780.734,
+        mean: 3780.861,
         longest: 3880,
     },
 ];
