@@ -73,12 +73,15 @@ pub struct StepRecord {
     pub resonance_hz: f32,
 }
 
-/// Where the loop is within a period.
+/// Where the loop is within a period. The period's readings stay in `ClosedLoop::readings`
+/// (they carry the current sense's codes, a few hundred bytes): the control phase reads them
+/// in place rather than copying them in and out of the phase (600 instructions a step in
+/// QEMU, `bench stage ... / script` in docs/speed.md).
 #[derive(Debug, Clone, Copy)]
 enum Phase {
     Plant,
-    Control(SensorReadings),
-    Finish(SensorReadings, Output, Option<SensorFault>, bool),
+    Control,
+    Finish(Output, Option<SensorFault>, bool),
 }
 
 /// Who gives the loop its targets and its start.
@@ -104,6 +107,8 @@ pub struct ClosedLoop<'a> {
     command: f32,
     target_points: usize,
     phase: Phase,
+    /// The last plant phase's readings (`None` before the first).
+    readings: Option<SensorReadings>,
     judge: Judge,
     /// What commissioning measured before the run (`commission = true` scenes).
     commissioned: Option<CommissionResult>,
@@ -261,6 +266,7 @@ impl<'a> ClosedLoop<'a> {
             command: 0.0,
             target_points: 1,
             phase: Phase::Plant,
+            readings: None,
             judge: Judge::new(scene).ok_or(SimError::TooLarge)?,
             commissioned,
         })
@@ -289,7 +295,8 @@ impl<'a> ClosedLoop<'a> {
             return None;
         }
         let readings = self.plant.step(drive_amplitude, self.station.drive_hz());
-        self.phase = Phase::Control(readings);
+        self.phase = Phase::Control;
+        self.readings = Some(readings);
         Some(readings)
     }
 
@@ -304,7 +311,10 @@ impl<'a> ClosedLoop<'a> {
     /// step's cost, `sonolube::stage`); the same computation whatever the marks.
     pub fn control_phase_marked(&mut self, marks: &mut impl StageMarks) -> Option<Output> {
         marks.enter(Stage::Script);
-        let Phase::Control(readings) = self.phase else {
+        if !matches!(self.phase, Phase::Control) {
+            return None;
+        }
+        let Some(readings) = &self.readings else {
             return None;
         };
         let t_s = readings.truth.time_s;
@@ -337,14 +347,16 @@ impl<'a> ClosedLoop<'a> {
         marks.enter(Stage::Script);
         let output = control.output;
         self.command = output.amplitude.to_f32();
-        self.phase = Phase::Finish(readings, output, control.sensor_fault, target_step);
+        self.phase = Phase::Finish(output, control.sensor_fault, target_step);
         Some(output)
     }
 
     /// Phase 3: judges the step and returns its record. `None` unless a control phase is
     /// due for it.
     pub fn finish_step(&mut self) -> Option<StepRecord> {
-        let Phase::Finish(readings, output, sensor_fault, target_step) = self.phase else {
+        let (Phase::Finish(output, sensor_fault, target_step), Some(readings)) =
+            (self.phase, &self.readings)
+        else {
             return None;
         };
         self.phase = Phase::Plant;

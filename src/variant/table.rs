@@ -47,19 +47,19 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl update f64",
-        instructions: 2228.102,
+        instructions: 2228.17,
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 296.225,
+        instructions: 296.323,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 68.676,
+        instructions: 68.823,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 259.117,
+        instructions: 259.068,
     },
     Cost {
         variant: "Coulomb ratio f64",
@@ -67,11 +67,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11363.548,
+        instructions: 11363.44,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 5869.462,
+        instructions: 5869.731,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
@@ -79,75 +79,75 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 147229.89,
+        instructions: 147230.33,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20291.129,
+        instructions: 20291.29,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
-        instructions: 11294.516,
+        instructions: 11294.677,
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 58659.086,
+        instructions: 58658.227,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 269834.2,
+        instructions: 269834.84,
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 38005.97,
+        instructions: 38005.754,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22175.967,
+        instructions: 22176.451,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 111924.68,
+        instructions: 111924.086,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 511149.2,
+        instructions: 511145.6,
     },
     Cost {
         variant: "Dahl steady T=49x73",
-        instructions: 322.526,
+        instructions: 322.311,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 591.089,
+        instructions: 590.961,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
-        instructions: 378.012,
+        instructions: 377.948,
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 263.012,
+        instructions: 262.948,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9437.692,
+        instructions: 9437.564,
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 828.974,
+        instructions: 829.038,
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 631.794,
+        instructions: 632.051,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
-        instructions: 393.461,
+        instructions: 393.397,
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15243.525,
+        instructions: 15243.589,
     },
     Cost {
         variant: "cube el N=16",
@@ -155,59 +155,59 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
-        instructions: 1141.987,
+        instructions: 1141.923,
     },
     Cost {
         variant: "cube el N=16 f32 libm",
-        instructions: 657.692,
+        instructions: 657.564,
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26896.152,
+        instructions: 26896.346,
     },
     Cost {
         variant: "cube el N=32",
-        instructions: 2256.923,
+        instructions: 2256.794,
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.923,
+        instructions: 2161.858,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
-        instructions: 1183.717,
+        instructions: 1183.91,
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50148.203,
+        instructions: 50148.652,
     },
     Cost {
         variant: "cube el T=5x5",
-        instructions: 282.884,
+        instructions: 282.756,
     },
     Cost {
         variant: "cube el T=9x9",
-        instructions: 282.692,
+        instructions: 282.82,
     },
     Cost {
         variant: "cube el T=17x17",
-        instructions: 282.628,
+        instructions: 282.82,
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 591.025,
+        instructions: 590.961,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 378.012,
+        instructions: 377.948,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
-        instructions: 263.012,
+        instructions: 262.82,
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9428.717,
+        instructions: 9428.782,
     },
     Cost {
         variant: "cube ep N=8",
@@ -215,59 +215,59 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 632.051,
+        instructions: 631.858,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
-        instructions: 393.589,
+        instructions: 393.461,
     },
     Cost {
         variant: "cube ep N=8 f64",
-        instructions: 15231.602,
+        instructions: 15231.41,
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1304.807,
+        instructions: 1305.0,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
-        instructions: 1141.858,
+        instructions: 1141.987,
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 657.692,
+        instructions: 657.628,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26885.705,
+        instructions: 26885.64,
     },
     Cost {
         variant: "cube ep N=32",
-        instructions: 2257.051,
+        instructions: 2256.858,
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
-        instructions: 2161.923,
+        instructions: 2161.73,
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
-        instructions: 1183.974,
+        instructions: 1183.846,
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50137.31,
+        instructions: 50137.18,
     },
     Cost {
         variant: "cube ep T=5x5",
-        instructions: 282.692,
+        instructions: 282.82,
     },
     Cost {
         variant: "cube ep T=9x9",
-        instructions: 282.82,
+        instructions: 282.756,
     },
     Cost {
         variant: "cube ep T=17x17",
-        instructions: 282.82,
+        instructions: 282.628,
     },
 ];
 
@@ -1253,97 +1253,97 @@ static ERRORS: &[SceneError] = &[
 static STEPS: &[StepCost] = &[
     StepCost {
         variant: "Coulomb ratio",
-        mean: 3225.44,
-        longest: 3520,
+        mean: 2844.0,
+        longest: 3160,
     },
     StepCost {
         variant: "Dahl steady N=16",
-        mean: 210488.8,
-        longest: 262440,
+        mean: 210108.16,
+        longest: 262080,
     },
     StepCost {
         variant: "Dahl steady N=32",
-        mean: 380543.53,
-        longest: 474160,
+        mean: 380165.44,
+        longest: 473800,
     },
     StepCost {
         variant: "Dahl steady N=64",
-        mean: 715539.06,
-        longest: 892120,
+        mean: 715156.2,
+        longest: 891720,
     },
     StepCost {
         variant: "Dahl steady T=49x73",
-        mean: 3879.2,
-        longest: 4520,
+        mean: 3498.56,
+        longest: 4160,
     },
     StepCost {
         variant: "cube el N=4",
-        mean: 4719.123,
-        longest: 6280,
+        mean: 4339.261,
+        longest: 5880,
     },
     StepCost {
         variant: "cube el N=8",
-        mean: 5708.163,
-        longest: 7800,
+        mean: 5328.247,
+        longest: 7400,
     },
     StepCost {
         variant: "cube el N=16",
-        mean: 7686.567,
-        longest: 10800,
+        mean: 7306.367,
+        longest: 10480,
     },
     StepCost {
         variant: "cube el N=32",
-        mean: 11642.985,
-        longest: 16880,
+        mean: 11262.941,
+        longest: 16520,
     },
     StepCost {
         variant: "cube el T=5x5",
-        mean: 3745.738,
-        longest: 3840,
+        mean: 3365.88,
+        longest: 3480,
     },
     StepCost {
         variant: "cube el T=9x9",
-        mean: 3771.883,
-        longest: 3880,
+        mean: 3391.836,
+        longest: 3520,
     },
     StepCost {
         variant: "cube el T=17x17",
-        mean: 3780.796,
-        longest: 3960,
+        mean: 3400.76,
+        longest: 3560,
     },
     StepCost {
         variant: "cube ep N=4",
-        mean: 4719.418,
-        longest: 6240,
+        mean: 4339.45,
+        longest: 5880,
     },
     StepCost {
         variant: "cube ep N=8",
-        mean: 5710.243,
-        longest: 7800,
+        mean: 5329.978,
+        longest: 7400,
     },
     StepCost {
         variant: "cube ep N=16",
-        mean: 7688.858,
-        longest: 10800,
+        mean: 7308.73,
+        longest: 10400,
     },
     StepCost {
         variant: "cube ep N=32",
-        mean: 11645.236,
-        longest: 16920,
+        mean: 11265.501,
+        longest: 16520,
     },
     StepCost {
         variant: "cube ep T=5x5",
-        mean: 3746.363,
-        longest: 3880,
+        mean: 3366.37,
+        longest: 3520,
     },
     StepCost {
         variant: "cube ep T=9x9",
-        mean: 3773.003,
-        longest: 3880,
+        mean: 3392.483,
+        longest: 3520,
     },
     StepCost {
         variant: "cube ep T=17x17",
-        mean: 3780.861,
-        longest: 3880,
+        mean: 3401.138,
+        longest: 3560,
     },
 ];
