@@ -19,11 +19,11 @@ pub static MEASURED: Measurements = Measurements {
 static COSTS: &[Cost] = &[
     Cost {
         variant: "Littmann closed form",
-        instructions: 49.688,
+        instructions: 49.669,
     },
     Cost {
         variant: "Littmann closed form f32 micromath",
-        instructions: 33.872,
+        instructions: 33.853,
     },
     Cost {
         variant: "Littmann closed form f32 libm",
@@ -31,7 +31,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Littmann closed form f64",
-        instructions: 3355.978,
+        instructions: 3356.017,
     },
     Cost {
         variant: "Dahl update",
@@ -51,51 +51,51 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 296.323,
+        instructions: 296.372,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 68.823,
+        instructions: 68.774,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 259.068,
+        instructions: 259.362,
     },
     Cost {
         variant: "Coulomb ratio f64",
-        instructions: 2719.901,
+        instructions: 2719.95,
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11363.44,
+        instructions: 11363.494,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 5869.731,
+        instructions: 5869.408,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 31846.396,
+        instructions: 31845.86,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 147230.33,
+        instructions: 147230.05,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20291.29,
+        instructions: 20291.506,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
-        instructions: 11294.677,
+        instructions: 11294.462,
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 58658.227,
+        instructions: 58658.117,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 269834.84,
+        instructions: 269834.53,
     },
     Cost {
         variant: "Dahl steady N=64",
@@ -103,35 +103,35 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22176.451,
+        instructions: 22175.912,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 111924.086,
+        instructions: 111925.055,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 511145.6,
+        instructions: 511145.97,
     },
     Cost {
         variant: "Dahl steady T=49x73",
-        instructions: 322.311,
+        instructions: 322.526,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 590.961,
+        instructions: 590.641,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
-        instructions: 377.948,
+        instructions: 378.076,
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 262.948,
+        instructions: 263.012,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9437.564,
+        instructions: 9437.82,
     },
     Cost {
         variant: "cube el N=8",
@@ -139,7 +139,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 632.051,
+        instructions: 631.858,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
@@ -147,27 +147,27 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15243.589,
+        instructions: 15243.525,
     },
     Cost {
         variant: "cube el N=16",
-        instructions: 1305.0,
+        instructions: 1304.871,
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
-        instructions: 1141.923,
+        instructions: 1141.987,
     },
     Cost {
         variant: "cube el N=16 f32 libm",
-        instructions: 657.564,
+        instructions: 657.628,
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26896.346,
+        instructions: 26895.705,
     },
     Cost {
         variant: "cube el N=32",
-        instructions: 2256.794,
+        instructions: 2257.115,
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
@@ -175,55 +175,55 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=32 f32 libm",
-        instructions: 1183.91,
+        instructions: 1183.846,
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50148.652,
+        instructions: 50148.14,
     },
     Cost {
         variant: "cube el T=5x5",
-        instructions: 282.756,
+        instructions: 282.82,
     },
     Cost {
         variant: "cube el T=9x9",
-        instructions: 282.82,
+        instructions: 282.564,
     },
     Cost {
         variant: "cube el T=17x17",
-        instructions: 282.82,
+        instructions: 282.692,
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 590.961,
+        instructions: 590.833,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 377.948,
+        instructions: 378.141,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
-        instructions: 262.82,
+        instructions: 263.141,
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9428.782,
+        instructions: 9428.846,
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 828.91,
+        instructions: 829.038,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 631.858,
+        instructions: 632.051,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
-        instructions: 393.461,
+        instructions: 393.525,
     },
     Cost {
         variant: "cube ep N=8 f64",
-        instructions: 15231.41,
+        instructions: 15231.602,
     },
     Cost {
         variant: "cube ep N=16",
@@ -231,15 +231,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
-        instructions: 1141.987,
+        instructions: 1141.923,
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 657.628,
+        instructions: 657.435,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26885.64,
+        instructions: 26885.896,
     },
     Cost {
         variant: "cube ep N=32",
@@ -247,7 +247,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
-        instructions: 2161.73,
+        instructions: 2161.794,
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
@@ -255,11 +255,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50137.18,
+        instructions: 50137.242,
     },
     Cost {
         variant: "cube ep T=5x5",
-        instructions: 282.82,
+        instructions: 282.884,
     },
     Cost {
         variant: "cube ep T=9x9",
@@ -267,7 +267,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep T=17x17",
-        instructions: 282.628,
+        instructions: 282.82,
     },
 ];
 
@@ -1253,97 +1253,97 @@ static ERRORS: &[SceneError] = &[
 static STEPS: &[StepCost] = &[
     StepCost {
         variant: "Coulomb ratio",
-        mean: 2844.0,
+        mean: 2845.12,
         longest: 3160,
     },
     StepCost {
         variant: "Dahl steady N=16",
-        mean: 210108.16,
-        longest: 262080,
+        mean: 210106.72,
+        longest: 262040,
     },
     StepCost {
         variant: "Dahl steady N=32",
-        mean: 380165.44,
+        mean: 380164.63,
         longest: 473800,
     },
     StepCost {
         variant: "Dahl steady N=64",
-        mean: 715156.2,
+        mean: 715157.75,
         longest: 891720,
     },
     StepCost {
         variant: "Dahl steady T=49x73",
-        mean: 3498.56,
+        mean: 3499.84,
         longest: 4160,
     },
     StepCost {
         variant: "cube el N=4",
-        mean: 4339.261,
-        longest: 5880,
+        mean: 4339.145,
+        longest: 5920,
     },
     StepCost {
         variant: "cube el N=8",
-        mean: 5328.247,
+        mean: 5328.294,
         longest: 7400,
     },
     StepCost {
         variant: "cube el N=16",
-        mean: 7306.367,
-        longest: 10480,
+        mean: 7306.458,
+        longest: 10440,
     },
     StepCost {
         variant: "cube el N=32",
-        mean: 11262.941,
-        longest: 16520,
+        mean: 11263.003,
+        longest: 16480,
     },
     StepCost {
         variant: "cube el T=5x5",
-        mean: 3365.88,
+        mean: 3366.24,
         longest: 3480,
     },
     StepCost {
         variant: "cube el T=9x9",
-        mean: 3391.836,
+        mean: 3391.93,
         longest: 3520,
     },
     StepCost {
         variant: "cube el T=17x17",
-        mean: 3400.76,
+        mean: 3400.814,
         longest: 3560,
     },
     StepCost {
         variant: "cube ep N=4",
-        mean: 4339.45,
+        mean: 4339.287,
         longest: 5880,
     },
     StepCost {
         variant: "cube ep N=8",
-        mean: 5329.978,
-        longest: 7400,
+        mean: 5329.996,
+        longest: 7440,
     },
     StepCost {
         variant: "cube ep N=16",
-        mean: 7308.73,
-        longest: 10400,
+        mean: 7308.683,
+        longest: 10440,
     },
     StepCost {
         variant: "cube ep N=32",
-        mean: 11265.501,
+        mean: 11265.356,
         longest: 16520,
     },
     StepCost {
         variant: "cube ep T=5x5",
-        mean: 3366.37,
-        longest: 3520,
+        mean: 3366.323,
+        longest: 3480,
     },
     StepCost {
         variant: "cube ep T=9x9",
-        mean: 3392.483,
+        mean: 3392.694,
         longest: 3520,
     },
     StepCost {
         variant: "cube ep T=17x17",
-        mean: 3401.138,
-        longest: 3560,
+        mean: 3400.883,
+        longest: 3520,
     },
 ];

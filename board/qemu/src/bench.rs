@@ -443,7 +443,7 @@ fn control_step(name: &str, scene_name: &str, fidelity: Fidelity, table: u8, shi
     .map_err(SimError::Model)
     .and_then(|model| ClosedLoop::with_model(&scene, model));
     match rerun {
-        Ok(mut run) => stage_breakdown(name, &mut run, tally.calls, shift),
+        Ok(mut run) => stage_breakdown("", name, &mut run, tally.calls, shift),
         Err(error) => {
             defmt::error!("bench stage {=str}: {}", name, error);
             false
@@ -501,9 +501,9 @@ impl StageClock {
         )
     }
 
-    /// Prints `bench stage NAME / STAGE: N.NNN instructions per call (S calls)` for every
-    /// stage, per step of `steps`, the marks' cost `(cycles, marks)` taken off.
-    fn report(&self, name: &str, steps: u64, mark: (u64, u64), shift: u32) {
+    /// Prints `bench stage PREFIXNAME / STAGE: N.NNN instructions per call (S calls)` for
+    /// every stage, per step of `steps`, the marks' cost `(cycles, marks)` taken off.
+    fn report(&self, prefix: &str, name: &str, steps: u64, mark: (u64, u64), shift: u32) {
         for stage in Stage::ALL {
             let i = stage.index();
             let marks_cost = (self.intervals[i] * mark.0)
@@ -513,7 +513,8 @@ impl StageClock {
             // A stage a scene never enters (no resonance loop) is reported as 0.
             let milli = milli_instructions(net, steps, shift).unwrap_or(0);
             defmt::info!(
-                "bench stage {=str} / {=str}: {=u64}.{=u64:03} instructions per call ({=u64} calls)",
+                "bench stage {=str}{=str} / {=str}: {=u64}.{=u64:03} instructions per call ({=u64} calls)",
+                prefix,
                 name,
                 stage.name(),
                 milli / 1000,
@@ -534,7 +535,13 @@ impl StageMarks for StageClock {
 /// Runs `closed_loop` to its end with its control phases' stages marked, and prints the
 /// instructions per step of each stage; false unless it ran `steps` steps, as the unmarked
 /// run did.
-fn stage_breakdown(name: &str, closed_loop: &mut ClosedLoop, steps: u64, shift: u32) -> bool {
+fn stage_breakdown(
+    prefix: &str,
+    name: &str,
+    closed_loop: &mut ClosedLoop,
+    steps: u64,
+    shift: u32,
+) -> bool {
     let mark = StageClock::calibrate();
     let mut clock = StageClock::new();
     let mut marked = 0;
@@ -553,14 +560,15 @@ fn stage_breakdown(name: &str, closed_loop: &mut ClosedLoop, steps: u64, shift: 
     }
     if marked != steps {
         defmt::error!(
-            "bench stage {=str}: {=u64} steps marked, {=u64} timed",
+            "bench stage {=str}{=str}: {=u64} steps marked, {=u64} timed",
+            prefix,
             name,
             marked,
             steps
         );
         return false;
     }
-    clock.report(name, steps, mark, shift);
+    clock.report(prefix, name, steps, mark, shift);
     true
 }
 
@@ -644,7 +652,17 @@ fn variant_step(variant: &Variant, scene_name: &str, shift: u32) -> bool {
         tally.calls,
         (longest * NS_PER_CYCLE) >> shift
     );
-    true
+    // Its stages, on a fresh run of the same steps.
+    let rerun = fixed_model(scene, variant)
+        .map_err(SimError::Model)
+        .and_then(|model| ClosedLoop::with_model(scene, model));
+    match rerun {
+        Ok(mut run) => stage_breakdown("step ", variant.name, &mut run, tally.calls, shift),
+        Err(error) => {
+            defmt::error!("bench stage step {=str}: {}", variant.name, error);
+            false
+        }
+    }
 }
 
 /// Runs `closed_loop` to its end, timing each control phase (the plant's phase and the step's

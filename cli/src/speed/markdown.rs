@@ -10,7 +10,7 @@ use sonolube::variant::{CATALOGUE, CONTROL_STEPS, Family, Fidelity, find, grid};
 
 use super::errors::{Errors, Stats};
 use super::fronts::{Set, Standing, is_kernel, standing};
-use super::qemu::{Counts, build_name, inverse_name, stage_name, step_name};
+use super::qemu::{Counts, build_name, inverse_name, stage_name, staged_steps, step_name};
 use super::table_rs::COMMAND;
 use super::timing::{SAMPLE_TIME, SAMPLES};
 
@@ -236,7 +236,8 @@ impl Report<'_> {
             let _ = write!(s, "---:|");
         }
         let _ = writeln!(s, "---:|---:|---:|");
-        for &(name, ..) in CONTROL_STEPS {
+        for name in &staged_steps() {
+            let name = name.as_str();
             let stages: Vec<Option<f64>> = Stage::ALL
                 .iter()
                 .map(|&stage| self.instructions(&stage_name(name, stage)))
@@ -572,7 +573,8 @@ impl Report<'_> {
         let _ = writeln!(
             s,
             "## Where a control step's instructions go\n\n\
-             Each control-step row's run again with its stages marked (`sonolube::stage`: \
+             Each control-step row, and each fixed-point variant's step of the period budget \
+             above (`step NAME`, on its step scene), run again with its stages marked (`sonolube::stage`: \
              `ClosedLoop::control_phase_marked`, the same steps bit for bit; the firmware's step \
              is the unmarked code), the instructions between two marks charged to the stage \
              that ran, counted in QEMU as above (`bench stage NAME / STAGE`), per step. Each \
@@ -585,7 +587,7 @@ impl Report<'_> {
              the operating point and F'/F at the applied drive; *inverse*: the amplitude for the \
              commanded ratio; *feedback*: the target's ratio, the prediction's filters, the PI \
              and the net-force hold; *shaper*: slew, soft start, envelope. *outside the stages*: \
-             the whole step (unmarked, the row above) less the sum (the call into the phase, and \
+             the whole step (unmarked, the rows above) less the sum (the call into the phase, and \
              code the marks made the compiler lay out differently):\n"
         );
         self.stage_breakdown(&mut s);

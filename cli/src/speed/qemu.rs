@@ -114,11 +114,21 @@ pub fn stage_name(step: &str, stage: Stage) -> String {
     format!("stage {step} / {}", stage.name())
 }
 
-/// Names of every stage count of the control-step rows.
-pub fn stage_names() -> Vec<String> {
+/// Every control step broken down by stage: the control-step rows, then the variants' steps
+/// (`step NAME`).
+pub fn staged_steps() -> Vec<String> {
     CONTROL_STEPS
         .iter()
-        .flat_map(|c| Stage::ALL.iter().map(|&stage| stage_name(c.0, stage)))
+        .map(|c| c.0.to_string())
+        .chain(step_names())
+        .collect()
+}
+
+/// Names of every stage count of [`staged_steps`].
+pub fn stage_names() -> Vec<String> {
+    staged_steps()
+        .iter()
+        .flat_map(|step| Stage::ALL.iter().map(|&stage| stage_name(step, stage)))
         .collect()
 }
 
@@ -206,8 +216,11 @@ mod tests {
                 + CONTROL_STEPS.len()
                 + tables
                 + step_names().len()
-                + CONTROL_STEPS.len() * Stage::ALL.len()
+                + (CONTROL_STEPS.len() + step_names().len()) * Stage::ALL.len()
         );
+        let name = stage_name(&step_name("Dahl steady T=49x73"), Stage::Inverse);
+        assert_eq!(name, "stage step Dahl steady T=49x73 / inverse");
+        assert!(counts.contains_key(&name));
         let no_stage = full_log().replace("bench stage control step / inverse:", "bench other:");
         assert!(
             parse(&no_stage)
