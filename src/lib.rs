@@ -18,5 +18,6 @@ pub mod scene;
 pub mod selfcheck;
 pub mod sense;
 pub mod settings;
+pub mod stage;
 pub mod station;
 pub mod variant;

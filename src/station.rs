@@ -37,6 +37,7 @@ use crate::protocol::DRIVE_FREQ;
 use crate::protocol::{Axis, Command, ProtocolError, SupervisorState, TareAxes, TokenText};
 use crate::scene::Scene;
 use crate::sense::{SampleError, SensorChannel};
+use crate::stage::{Stage, StageMarks};
 use crate::variant::{Selection, select};
 
 mod commission;
@@ -331,6 +332,13 @@ impl Station {
     /// calibration) to newtons, a fault found there as the controller's sensor fault, and the
     /// controller step.
     pub fn control(&mut self, sample: &Sample) -> Control {
+        self.control_marked(sample, &mut ())
+    }
+
+    /// [`Self::control`] with its stages marked in `marks` (the benchmark's breakdown of a
+    /// step's cost, [`crate::stage`]); the same computation whatever the marks.
+    pub fn control_marked(&mut self, sample: &Sample, marks: &mut impl StageMarks) -> Control {
+        marks.enter(Stage::Sensing);
         let (normal_force, normal_fault) =
             sense(&mut self.normal, sample.normal_code, Sensor::NormalForce);
         let (tangential_force, tangential_fault) = sense(
@@ -345,8 +353,9 @@ impl Station {
             sliding_velocity: Q8_24::from_f32_saturating(sample.sliding_velocity_m_per_s).value,
             sensor_fault,
         };
-        let mut output = self.controller.step(&inputs, &self.model);
+        let mut output = self.controller.step_marked(&inputs, &self.model, marks);
         // Issue 27: in a motor region the net-force hold drives instead of the friction path.
+        marks.enter(Stage::Feedback);
         if let Some(motor) = self.motor.as_mut()
             && let motor_hold::HoldOutcome::Motor(amplitude) = motor.step(
                 sample.sliding_velocity_m_per_s,
@@ -360,6 +369,7 @@ impl Station {
             output.amplitude = amplitude;
             self.controller.drive_replaced(amplitude);
         }
+        marks.enter(Stage::Resonance);
         if let Some(resonance) = self.resonance.as_ref() {
             let drive_allowed = output.fault.is_none()
                 && (self.start_pending
@@ -389,6 +399,7 @@ impl Station {
                 let _ = self.controller.start();
             }
         }
+        marks.enter(Stage::Supervision);
         self.applied = Amplitude::from_command(output.amplitude);
         self.commission_period(
             &mut output,

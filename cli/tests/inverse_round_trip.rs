@@ -3,7 +3,9 @@
 //! operating grid, the target is the exact f64 model's ratio at a grid point, the inverse gives
 //! an amplitude, and the exact f64 model's ratio at that amplitude is the target again:
 //! `ratio(invert(r)) = r` against the independent reference, not against the variant's own
-//! forward model (which a shared bug would satisfy).
+//! forward model (which a shared bug would satisfy). The controller's call, `invert_from`
+//! (from the last step's amplitude), is held to the same bound from starts near the answer,
+//! far from it and at both ends of the range.
 //!
 //! The bound of a variant is its stated accuracy as a forward model (the inverse lands on its
 //! own forward value, which is that far from the reference) plus 2e-6 for the inverse's
@@ -76,31 +78,43 @@ fn every_inverse_returns_to_its_target_on_the_reference() {
                     // every amplitude: the inverse refuses, unit-tested with each model).
                     continue;
                 }
-                let inv = model.invert(&p.point, target).unwrap();
                 let t = target.to_f64();
-                let error = match inv.reach {
-                    Reach::Reached => (exact(&p, inv.amplitude) - t).abs(),
-                    // The variant's own floor may sit above a reachable target by its error.
-                    Reach::BelowMinimum => {
-                        (model.ratio(&p.point, Q1_31::MAX).unwrap().to_f64() - t).max(0.0)
-                    }
-                    Reach::AboveNatural => {
-                        panic!(
-                            "{} on {}: {t} reported above natural",
-                            variant.name, scene.name
-                        )
-                    }
-                };
-                assert!(
-                    error <= bound + 2e-6,
-                    "{} on {} at W {} N, v {} m/s: target {t}, {inv:?}, off by {error:.2e} \
+                // The cold inverse, and the controller's call: from a start nearby (last
+                // step's amplitude, a little off), from one far off, and from the ends.
+                let near = Q1_31::from_f64(p.amplitude.to_f64() * 0.995).unwrap();
+                let far = Q1_31::from_f64(p.amplitude.to_f64() * 0.3).unwrap();
+                for inv in [
+                    model.invert(&p.point, target),
+                    model.invert_from(&p.point, target, near),
+                    model.invert_from(&p.point, target, far),
+                    model.invert_from(&p.point, target, Q1_31::ZERO),
+                    model.invert_from(&p.point, target, Q1_31::MAX),
+                ] {
+                    let inv = inv.unwrap();
+                    let error = match inv.reach {
+                        Reach::Reached => (exact(&p, inv.amplitude) - t).abs(),
+                        // The variant's own floor may sit above a reachable target by its error.
+                        Reach::BelowMinimum => {
+                            (model.ratio(&p.point, Q1_31::MAX).unwrap().to_f64() - t).max(0.0)
+                        }
+                        Reach::AboveNatural => {
+                            panic!(
+                                "{} on {}: {t} reported above natural",
+                                variant.name, scene.name
+                            )
+                        }
+                    };
+                    assert!(
+                        error <= bound + 2e-6,
+                        "{} on {} at W {} N, v {} m/s: target {t}, {inv:?}, off by {error:.2e} \
                      (bound {bound:.0e})",
-                    variant.name,
-                    scene.name,
-                    p.load_n(),
-                    p.velocity_m_per_s()
-                );
-                worst = worst.max(error);
+                        variant.name,
+                        scene.name,
+                        p.load_n(),
+                        p.velocity_m_per_s()
+                    );
+                    worst = worst.max(error);
+                }
                 points += 1;
             }
         }

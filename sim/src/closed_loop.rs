@@ -31,6 +31,7 @@ use sonolube::fx::Q1_31;
 use sonolube::model::AnyModel;
 use sonolube::protocol::{Axis, Command, ProtocolError, SupervisorState, Target, TargetRange};
 use sonolube::scene::{Breakpoint, Scene};
+use sonolube::stage::{Stage, StageMarks};
 use sonolube::station::{CellBench, Sample, Station};
 
 /// One control step of a run, for plots, CSV files and checks.
@@ -72,12 +73,15 @@ pub struct StepRecord {
     pub resonance_hz: f32,
 }
 
-/// Where the loop is within a period.
+/// Where the loop is within a period. The period's readings stay in `ClosedLoop::readings`
+/// (they carry the current sense's codes, a few hundred bytes): the control phase reads them
+/// in place rather than copying them in and out of the phase (600 instructions a step in
+/// QEMU, `bench stage ... / script` in docs/speed.md).
 #[derive(Debug, Clone, Copy)]
 enum Phase {
     Plant,
-    Control(SensorReadings),
-    Finish(SensorReadings, Output, Option<SensorFault>, bool),
+    Control,
+    Finish(Output, Option<SensorFault>, bool),
 }
 
 /// Who gives the loop its targets and its start.
@@ -103,6 +107,8 @@ pub struct ClosedLoop<'a> {
     command: f32,
     target_points: usize,
     phase: Phase,
+    /// The last plant phase's readings (`None` before the first).
+    readings: Option<SensorReadings>,
     judge: Judge,
     /// What commissioning measured before the run (`commission = true` scenes).
     commissioned: Option<CommissionResult>,
@@ -260,6 +266,7 @@ impl<'a> ClosedLoop<'a> {
             command: 0.0,
             target_points: 1,
             phase: Phase::Plant,
+            readings: None,
             judge: Judge::new(scene).ok_or(SimError::TooLarge)?,
             commissioned,
         })
@@ -288,7 +295,8 @@ impl<'a> ClosedLoop<'a> {
             return None;
         }
         let readings = self.plant.step(drive_amplitude, self.station.drive_hz());
-        self.phase = Phase::Control(readings);
+        self.phase = Phase::Control;
+        self.readings = Some(readings);
         Some(readings)
     }
 
@@ -296,7 +304,17 @@ impl<'a> ClosedLoop<'a> {
     /// output (its `amplitude` is the command for the next period). `None` unless a plant
     /// phase is due for control.
     pub fn control_phase(&mut self) -> Option<Output> {
-        let Phase::Control(readings) = self.phase else {
+        self.control_phase_marked(&mut ())
+    }
+
+    /// Phase 2 with its stages marked in `marks` (the benchmark's breakdown of a control
+    /// step's cost, `sonolube::stage`); the same computation whatever the marks.
+    pub fn control_phase_marked(&mut self, marks: &mut impl StageMarks) -> Option<Output> {
+        marks.enter(Stage::Script);
+        if !matches!(self.phase, Phase::Control) {
+            return None;
+        }
+        let Some(readings) = &self.readings else {
             return None;
         };
         let t_s = readings.truth.time_s;
@@ -312,26 +330,33 @@ impl<'a> ClosedLoop<'a> {
             // interpolates between two of them: the command is accepted.
             let _ = self.station.controller_mut().set_target(target);
         }
+        marks.enter(Stage::Resonance);
         let count = usize::from(readings.current_count);
         if count > 0 {
             self.station
                 .push_current(readings.current_codes.get(..count).unwrap_or(&[]));
         }
-        let control = self.station.control(&Sample {
-            normal_code: readings.normal_code,
-            tangential_code: readings.tangential_code,
-            sliding_velocity_m_per_s: readings.sliding_velocity_m_per_s,
-        });
+        let control = self.station.control_marked(
+            &Sample {
+                normal_code: readings.normal_code,
+                tangential_code: readings.tangential_code,
+                sliding_velocity_m_per_s: readings.sliding_velocity_m_per_s,
+            },
+            marks,
+        );
+        marks.enter(Stage::Script);
         let output = control.output;
         self.command = output.amplitude.to_f32();
-        self.phase = Phase::Finish(readings, output, control.sensor_fault, target_step);
+        self.phase = Phase::Finish(output, control.sensor_fault, target_step);
         Some(output)
     }
 
     /// Phase 3: judges the step and returns its record. `None` unless a control phase is
     /// due for it.
     pub fn finish_step(&mut self) -> Option<StepRecord> {
-        let Phase::Finish(readings, output, sensor_fault, target_step) = self.phase else {
+        let (Phase::Finish(output, sensor_fault, target_step), Some(readings)) =
+            (self.phase, &self.readings)
+        else {
             return None;
         };
         self.phase = Phase::Plant;

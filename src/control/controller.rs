@@ -18,6 +18,7 @@ use super::target::PreparedTarget;
 use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
 use crate::model::{FrictionModel, ModelError, OperatingPoint, Reach};
 use crate::protocol::{SupervisorState, Target};
+use crate::stage::{Stage, StageMarks};
 
 /// The load at which a model whose load enters only through `mu W` (the Dahl steady state,
 /// [`FrictionModel::load_enters_as_coulomb_force`]) sees the measured Coulomb force: `W mu0 /
@@ -202,22 +203,36 @@ impl Controller {
     /// A sensor fault (reported or implausible) or a model error puts the drive at zero in
     /// this very step.
     pub fn step<M: FrictionModel + ?Sized>(&mut self, inputs: &Inputs, model: &M) -> Output {
+        self.step_marked(inputs, model, &mut ())
+    }
+
+    /// [`Self::step`] with its stages marked in `marks` (the benchmark's breakdown of a
+    /// step's cost, [`crate::stage`]); the same computation whatever the marks.
+    pub fn step_marked<M: FrictionModel + ?Sized>(
+        &mut self,
+        inputs: &Inputs,
+        model: &M,
+        marks: &mut impl StageMarks,
+    ) -> Output {
+        marks.enter(Stage::Supervision);
         let before = self.state.supervisor.state();
         match inputs.sensor_fault.or_else(|| self.implausible(inputs)) {
             Some(fault) => self.state.supervisor.latch(fault.into()),
-            None => self.estimate(inputs, model),
+            None => self.estimate(inputs, model, marks),
         }
         self.on_transition(before);
         let mut report = LoopReport::default();
         match self.state.supervisor.state() {
             SupervisorState::RampUp | SupervisorState::Running => {
-                if self.close_loop(model, &mut report).is_err() {
+                if self.close_loop(model, &mut report, marks).is_err() {
+                    marks.enter(Stage::Supervision);
                     self.state.supervisor.latch(Reason::ModelError);
                     self.state.shaper.apply(&self.config.shaper, Q1_31::ZERO);
                     report = LoopReport::default();
                 }
             }
             SupervisorState::RampDown => {
+                marks.enter(Stage::Shaper);
                 let s = &mut self.state;
                 let lowered = s
                     .shaper
@@ -234,8 +249,12 @@ impl Controller {
                     s.supervisor.finish_ramp_down();
                 }
             }
-            _ => self.state.shaper.apply(&self.config.shaper, Q1_31::ZERO),
+            _ => {
+                marks.enter(Stage::Shaper);
+                self.state.shaper.apply(&self.config.shaper, Q1_31::ZERO)
+            }
         }
+        marks.enter(Stage::Supervision);
         self.output(report)
     }
 
@@ -258,14 +277,21 @@ impl Controller {
         }
     }
 
-    fn estimate<M: FrictionModel + ?Sized>(&mut self, inputs: &Inputs, model: &M) {
+    fn estimate<M: FrictionModel + ?Sized>(
+        &mut self,
+        inputs: &Inputs,
+        model: &M,
+        marks: &mut impl StageMarks,
+    ) {
         let (c, s) = (&self.config, &mut self.state);
+        marks.enter(Stage::Estimator);
         s.estimate = s.estimator.update(
             &c.estimator,
             inputs.normal_force,
             inputs.tangential_force,
             inputs.sliding_velocity,
         );
+        marks.enter(Stage::Supervision);
         s.contact = match (
             c.sliding.process(&mut s.sliding, inputs.sliding_velocity),
             s.estimate.load_ok,
@@ -314,8 +340,10 @@ impl Controller {
         &mut self,
         model: &M,
         report: &mut LoopReport,
+        marks: &mut impl StageMarks,
     ) -> Result<(), ModelError> {
         let (c, s) = (&self.config, &mut self.state);
+        marks.enter(Stage::Feedback);
         let Some((_, target)) = s.target else {
             // start() refuses without a target and targets cannot be removed.
             s.supervisor.stop();
@@ -343,6 +371,7 @@ impl Controller {
             report.saturation.integral_frozen = true;
             Q1_31::ZERO
         } else {
+            marks.enter(Stage::Model);
             let point = operating_point(model, c, s)?;
             // The reference: what the model says the cells should read now, given the drive
             // actually applied (envelope estimate) and the same filter as the measurement.
@@ -353,6 +382,7 @@ impl Controller {
             } else {
                 model.ratio(&point, envelope)?
             };
+            marks.enter(Stage::Feedback);
             if !s.prediction_valid {
                 let seed = measured.saturating_add(s.pi.correction()).value;
                 s.prediction.reset(seed);
@@ -380,7 +410,9 @@ impl Controller {
                 .value
                 .saturating_add(candidate.correction())
                 .value;
+            marks.enter(Stage::Inverse);
             let inversion = model.invert_from(&point, command.max(Q2_30::ZERO), s.feedforward)?;
+            marks.enter(Stage::Feedback);
             s.feedforward = inversion.amplitude;
             let actuator = inversion.amplitude > max;
             let desired = inversion.amplitude.min(max);
@@ -403,9 +435,11 @@ impl Controller {
             report.saturation.integral_frozen = s.pi.frozen();
             desired
         };
+        marks.enter(Stage::Shaper);
         let shaped = c
             .shaper
             .process(&mut s.shaper, DriveRequest { desired, ceiling });
+        marks.enter(Stage::Supervision);
         report.saturation.slew = shaped.slew_limited;
         report.saturation.soft_start = ramping && shaped.ceiling_limited;
         s.supervisor

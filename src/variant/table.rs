@@ -19,19 +19,19 @@ pub static MEASURED: Measurements = Measurements {
 static COSTS: &[Cost] = &[
     Cost {
         variant: "Littmann closed form",
-        instructions: 49.688,
+        instructions: 49.669,
     },
     Cost {
         variant: "Littmann closed form f32 micromath",
-        instructions: 33.891,
+        instructions: 33.853,
     },
     Cost {
         variant: "Littmann closed form f32 libm",
-        instructions: 417.807,
+        instructions: 417.826,
     },
     Cost {
         variant: "Littmann closed form f64",
-        instructions: 3356.055,
+        instructions: 3356.017,
     },
     Cost {
         variant: "Dahl update",
@@ -39,11 +39,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl update f32 micromath",
-        instructions: 107.111,
+        instructions: 107.282,
     },
     Cost {
         variant: "Dahl update f32 libm",
-        instructions: 61.641,
+        instructions: 61.572,
     },
     Cost {
         variant: "Dahl update f64",
@@ -55,31 +55,31 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 68.627,
+        instructions: 68.774,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 259.117,
+        instructions: 259.362,
     },
     Cost {
         variant: "Coulomb ratio f64",
-        instructions: 2720.147,
+        instructions: 2719.95,
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11363.655,
+        instructions: 11363.494,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 5869.623,
+        instructions: 5869.408,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 31846.074,
+        instructions: 31845.86,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 147230.16,
+        instructions: 147230.05,
     },
     Cost {
         variant: "Dahl steady N=32",
@@ -87,51 +87,51 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
-        instructions: 11294.408,
+        instructions: 11294.462,
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 58658.816,
+        instructions: 58658.117,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 269835.0,
+        instructions: 269834.53,
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 38005.914,
+        instructions: 38005.754,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22176.182,
+        instructions: 22175.912,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 111925.43,
+        instructions: 111925.055,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 511149.2,
+        instructions: 511145.97,
     },
     Cost {
         variant: "Dahl steady T=49x73",
-        instructions: 322.096,
+        instructions: 322.526,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 590.961,
+        instructions: 590.641,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
-        instructions: 377.82,
+        instructions: 378.076,
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 263.076,
+        instructions: 263.012,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9437.756,
+        instructions: 9437.82,
     },
     Cost {
         variant: "cube el N=8",
@@ -139,7 +139,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 631.987,
+        instructions: 631.858,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
@@ -147,15 +147,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15243.653,
+        instructions: 15243.525,
     },
     Cost {
         variant: "cube el N=16",
-        instructions: 1304.807,
+        instructions: 1304.871,
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
-        instructions: 1141.858,
+        instructions: 1141.987,
     },
     Cost {
         variant: "cube el N=16 f32 libm",
@@ -163,15 +163,15 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=16 f64",
-        instructions: 26895.896,
+        instructions: 26895.705,
     },
     Cost {
         variant: "cube el N=32",
-        instructions: 2257.051,
+        instructions: 2257.115,
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.987,
+        instructions: 2161.858,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
@@ -179,7 +179,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50148.59,
+        instructions: 50148.14,
     },
     Cost {
         variant: "cube el T=5x5",
@@ -187,11 +187,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el T=9x9",
-        instructions: 282.756,
+        instructions: 282.564,
     },
     Cost {
         variant: "cube el T=17x17",
-        instructions: 282.756,
+        instructions: 282.692,
     },
     Cost {
         variant: "cube ep N=4",
@@ -199,47 +199,47 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 378.076,
+        instructions: 378.141,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
-        instructions: 263.076,
+        instructions: 263.141,
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9428.653,
+        instructions: 9428.846,
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 828.974,
+        instructions: 829.038,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 631.794,
+        instructions: 632.051,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
-        instructions: 393.653,
+        instructions: 393.525,
     },
     Cost {
         variant: "cube ep N=8 f64",
-        instructions: 15231.346,
+        instructions: 15231.602,
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1304.807,
+        instructions: 1305.0,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
-        instructions: 1141.987,
+        instructions: 1141.923,
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 657.628,
+        instructions: 657.435,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26885.77,
+        instructions: 26885.896,
     },
     Cost {
         variant: "cube ep N=32",
@@ -247,11 +247,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
-        instructions: 2161.858,
+        instructions: 2161.794,
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
-        instructions: 1183.91,
+        instructions: 1183.846,
     },
     Cost {
         variant: "cube ep N=32 f64",
@@ -267,7 +267,7 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep T=17x17",
-        instructions: 282.628,
+        instructions: 282.82,
     },
 ];
 
@@ -1253,97 +1253,97 @@ static ERRORS: &[SceneError] = &[
 static STEPS: &[StepCost] = &[
     StepCost {
         variant: "Coulomb ratio",
-        mean: 3229.92,
-        longest: 3520,
+        mean: 2845.12,
+        longest: 3160,
     },
     StepCost {
         variant: "Dahl steady N=16",
-        mean: 210488.64,
-        longest: 262440,
+        mean: 210106.72,
+        longest: 262040,
     },
     StepCost {
         variant: "Dahl steady N=32",
-        mean: 380549.6,
-        longest: 474200,
+        mean: 380164.63,
+        longest: 473800,
     },
     StepCost {
         variant: "Dahl steady N=64",
-        mean: 715512.6,
-        longest: 892200,
+        mean: 715157.75,
+        longest: 891720,
     },
     StepCost {
         variant: "Dahl steady T=49x73",
-        mean: 3882.08,
-        longest: 4520,
+        mean: 3499.84,
+        longest: 4160,
     },
     StepCost {
         variant: "cube el N=4",
-        mean: 4717.156,
-        longest: 6280,
+        mean: 4339.145,
+        longest: 5920,
     },
     StepCost {
         variant: "cube el N=8",
-        mean: 5706.974,
-        longest: 7760,
+        mean: 5328.294,
+        longest: 7400,
     },
     StepCost {
         variant: "cube el N=16",
-        mean: 7684.036,
-        longest: 10800,
+        mean: 7306.458,
+        longest: 10440,
     },
     StepCost {
         variant: "cube el N=32",
-        mean: 11640.516,
-        longest: 16880,
+        mean: 11263.003,
+        longest: 16480,
     },
     StepCost {
         variant: "cube el T=5x5",
-        mean: 3745.185,
-        longest: 3880,
+        mean: 3366.24,
+        longest: 3480,
     },
     StepCost {
         variant: "cube el T=9x9",
-        mean: 3771.243,
-        longest: 3880,
+        mean: 3391.93,
+        longest: 3520,
     },
     StepCost {
         variant: "cube el T=17x17",
-        mean: 3779.745,
-        longest: 3880,
+        mean: 3400.814,
+        longest: 3560,
     },
     StepCost {
         variant: "cube ep N=4",
-        mean: 4719.68,
-        longest: 6240,
+        mean: 4339.287,
+        longest: 5880,
     },
     StepCost {
         variant: "cube ep N=8",
-        mean: 5706.927,
-        longest: 7760,
+        mean: 5329.996,
+        longest: 7440,
     },
     StepCost {
         variant: "cube ep N=16",
-        mean: 7685.84,
-        longest: 10800,
+        mean: 7308.683,
+        longest: 10440,
     },
     StepCost {
         variant: "cube ep N=32",
-        mean: 11645.072,
-        longest: 16880,
+        mean: 11265.356,
+        longest: 16520,
     },
     StepCost {
         variant: "cube ep T=5x5",
-        mean: 3745.709,
-        longest: 3880,
+        mean: 3366.323,
+        longest: 3480,
     },
     StepCost {
         variant: "cube ep T=9x9",
-        mean: 3771.41,
-        longest: 3880,
+        mean: 3392.694,
+        longest: 3520,
     },
     StepCost {
         variant: "cube ep T=17x17",
-        mean: 3780.734,
-        longest: 3880,
+        mean: 3400.883,
+        longest: 3520,
     },
 ];

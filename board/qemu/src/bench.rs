@@ -31,6 +31,11 @@
 //! nothing to build) have their inverse timed over the in-plane scenes' grids, the target being
 //! the ratio at each grid point: `bench inverse NAME: ...`.
 //!
+//! Each control-step row is then run again with its stages marked (`sonolube::stage`,
+//! `ClosedLoop::control_phase_marked`): the cycles between marks charged to the stage that ran,
+//! the marks' own cost (measured on back-to-back marks) taken off, per step: `bench stage
+//! NAME / STAGE: ...`.
+//!
 //! Output, one line per measurement (parsed by `sonolube speed`):
 //! `bench NAME: N.NNN instructions per call (C calls)`.
 
@@ -42,6 +47,7 @@ use sonolube::model::AnyModel;
 use sonolube::model::cube_table::CubeTable;
 use sonolube::model::{FrictionModel, OperatingPoint, dahl, littmann};
 use sonolube::scene::{ModelKind, ModelSpec, SCENES, Scene};
+use sonolube::stage::{Stage, StageMarks};
 use sonolube::variant::budget::step_scene;
 use sonolube::variant::fixed::fixed_model;
 use sonolube::variant::float_inplane::{dahl_update, littmann as float_littmann};
@@ -429,6 +435,140 @@ fn control_step(name: &str, scene_name: &str, fidelity: Fidelity, table: u8, shi
         tally.calls,
         (longest * NS_PER_CYCLE) >> shift
     );
+    // The same run again with its stages marked (a fresh run: the same steps, bit for bit).
+    let rerun = match lookup_table(fidelity, table) {
+        Some(variant) => fixed_model(&scene, variant),
+        None => AnyModel::new(&scene, &scene.controller),
+    }
+    .map_err(SimError::Model)
+    .and_then(|model| ClosedLoop::with_model(&scene, model));
+    match rerun {
+        Ok(mut run) => stage_breakdown("", name, &mut run, tally.calls, shift),
+        Err(error) => {
+            defmt::error!("bench stage {=str}: {}", name, error);
+            false
+        }
+    }
+}
+
+/// Charges the time between a control step's stage marks (`sonolube::stage`) to the stage
+/// that ran. Each interval between two marks also holds one mark's own cost (the end of the
+/// mark that opened it, the start of the one that closed it): [`StageClock::calibrate`]
+/// measures that cost on back-to-back marks, and [`StageClock::report`] takes it off.
+struct StageClock {
+    last: u64,
+    current: Option<Stage>,
+    cycles: [u64; Stage::ALL.len()],
+    intervals: [u64; Stage::ALL.len()],
+}
+
+impl StageClock {
+    fn new() -> Self {
+        Self {
+            last: time_driver::cycles(),
+            current: None,
+            cycles: [0; Stage::ALL.len()],
+            intervals: [0; Stage::ALL.len()],
+        }
+    }
+
+    /// `next` begins now (`None`: outside a step, not charged).
+    #[inline(never)]
+    fn switch(&mut self, next: Option<Stage>) {
+        let now = time_driver::cycles();
+        if let Some(stage) = self.current {
+            self.cycles[stage.index()] += now.saturating_sub(self.last);
+            self.intervals[stage.index()] += 1;
+        }
+        self.current = next;
+        self.last = now;
+    }
+
+    /// The cost of one mark in core cycles, as (cycles, marks): the mean over `MARKS`
+    /// back-to-back marks (each interval holds one mark's cost and nothing else).
+    fn calibrate() -> (u64, u64) {
+        const MARKS: u64 = 4096;
+        let mut clock = Self::new();
+        clock.switch(Some(Stage::Script));
+        for _ in 0..MARKS {
+            clock.enter(black_box(Stage::Script));
+        }
+        clock.switch(None);
+        watchdog::feed();
+        (
+            clock.cycles[Stage::Script.index()],
+            clock.intervals[Stage::Script.index()],
+        )
+    }
+
+    /// Prints `bench stage PREFIXNAME / STAGE: N.NNN instructions per call (S calls)` for
+    /// every stage, per step of `steps`, the marks' cost `(cycles, marks)` taken off.
+    fn report(&self, prefix: &str, name: &str, steps: u64, mark: (u64, u64), shift: u32) {
+        for stage in Stage::ALL {
+            let i = stage.index();
+            let marks_cost = (self.intervals[i] * mark.0)
+                .checked_div(mark.1)
+                .unwrap_or(0);
+            let net = self.cycles[i] as i64 - marks_cost as i64;
+            // A stage a scene never enters (no resonance loop) is reported as 0.
+            let milli = milli_instructions(net, steps, shift).unwrap_or(0);
+            defmt::info!(
+                "bench stage {=str}{=str} / {=str}: {=u64}.{=u64:03} instructions per call ({=u64} calls)",
+                prefix,
+                name,
+                stage.name(),
+                milli / 1000,
+                milli % 1000,
+                steps
+            );
+        }
+    }
+}
+
+impl StageMarks for StageClock {
+    #[inline(always)]
+    fn enter(&mut self, stage: Stage) {
+        self.switch(Some(stage));
+    }
+}
+
+/// Runs `closed_loop` to its end with its control phases' stages marked, and prints the
+/// instructions per step of each stage; false unless it ran `steps` steps, as the unmarked
+/// run did.
+fn stage_breakdown(
+    prefix: &str,
+    name: &str,
+    closed_loop: &mut ClosedLoop,
+    steps: u64,
+    shift: u32,
+) -> bool {
+    let mark = StageClock::calibrate();
+    let mut clock = StageClock::new();
+    let mut marked = 0;
+    while !closed_loop.is_finished() {
+        if closed_loop.plant_phase().is_none() {
+            break;
+        }
+        watchdog::feed();
+        clock.switch(None);
+        let control = closed_loop.control_phase_marked(&mut clock);
+        clock.switch(None);
+        if control.is_none() || closed_loop.finish_step().is_none() {
+            break;
+        }
+        marked += 1;
+    }
+    if marked != steps {
+        defmt::error!(
+            "bench stage {=str}{=str}: {=u64} steps marked, {=u64} timed",
+            prefix,
+            name,
+            marked,
+            steps
+        );
+        return false;
+    }
+    clock.report(prefix, name, steps, mark, shift);
     true
 }
 
@@ -512,7 +652,17 @@ fn variant_step(variant: &Variant, scene_name: &str, shift: u32) -> bool {
         tally.calls,
         (longest * NS_PER_CYCLE) >> shift
     );
-    true
+    // Its stages, on a fresh run of the same steps.
+    let rerun = fixed_model(scene, variant)
+        .map_err(SimError::Model)
+        .and_then(|model| ClosedLoop::with_model(scene, model));
+    match rerun {
+        Ok(mut run) => stage_breakdown("step ", variant.name, &mut run, tally.calls, shift),
+        Err(error) => {
+            defmt::error!("bench stage step {=str}: {}", variant.name, error);
+            false
+        }
+    }
 }
 
 /// Runs `closed_loop` to its end, timing each control phase (the plant's phase and the step's

@@ -10,7 +10,7 @@ use sonolube::variant::{CATALOGUE, CONTROL_STEPS, Family, Fidelity, find, grid};
 
 use super::errors::{Errors, Stats};
 use super::fronts::{Set, Standing, is_kernel, standing};
-use super::qemu::{Counts, build_name, inverse_name, step_name};
+use super::qemu::{Counts, build_name, inverse_name, stage_name, staged_steps, step_name};
 use super::table_rs::COMMAND;
 use super::timing::{SAMPLE_TIME, SAMPLES};
 
@@ -220,6 +220,45 @@ impl Report<'_> {
         }
     }
 
+    /// Where each control-step row's instructions go, stage by stage.
+    fn stage_breakdown(&self, s: &mut String) {
+        use sonolube::stage::Stage;
+        let _ = write!(s, "| control step |");
+        for stage in Stage::ALL {
+            let _ = write!(s, " {} |", stage.name());
+        }
+        let _ = writeln!(
+            s,
+            " sum of the stages | whole step (unmarked) | outside the stages |"
+        );
+        let _ = write!(s, "|---|");
+        for _ in Stage::ALL {
+            let _ = write!(s, "---:|");
+        }
+        let _ = writeln!(s, "---:|---:|---:|");
+        for name in &staged_steps() {
+            let name = name.as_str();
+            let stages: Vec<Option<f64>> = Stage::ALL
+                .iter()
+                .map(|&stage| self.instructions(&stage_name(name, stage)))
+                .collect();
+            let sum: Option<f64> = stages.iter().copied().sum();
+            let whole = self.instructions(name);
+            let _ = write!(s, "| {name} |");
+            for count in &stages {
+                let _ = write!(s, " {} |", count.map_or("-".into(), thousands));
+            }
+            let rest = sum.zip(whole).map(|(sum, whole)| whole - sum);
+            let _ = writeln!(
+                s,
+                " {} | {} | {} |",
+                sum.map_or("-".into(), thousands),
+                whole.map_or("-".into(), thousands),
+                rest.map_or("-".into(), thousands)
+            );
+        }
+    }
+
     /// The Dahl tables: storage in flash, evaluation and inverse costs, accuracy.
     fn dahl_tables(&self, s: &mut String) {
         let _ = writeln!(
@@ -295,7 +334,16 @@ impl Report<'_> {
             "| {dahl}: inverse at most 400 instructions | {inverse:.1} | {} |",
             met(inverse <= 400.0)
         );
+        // The inverse as the controller calls it (`invert_from`), in its step.
         let name = "control step Dahl steady T=49x73";
+        let in_step = self
+            .instructions(&stage_name(name, sonolube::stage::Stage::Inverse))
+            .unwrap_or(f64::INFINITY);
+        let _ = writeln!(
+            s,
+            "| {dahl}: inverse at most 400 instructions as the controller calls it (`invert_from`; stage *inverse* of `{name}`) | {in_step:.1} | {} |",
+            met(in_step <= 400.0)
+        );
         let (mean, longest) = self
             .counts
             .get(name)
@@ -521,6 +569,28 @@ impl Report<'_> {
              at 10 kHz:\n"
         );
         self.period_budget(&mut s);
+        s.push('\n');
+        let _ = writeln!(
+            s,
+            "## Where a control step's instructions go\n\n\
+             Each control-step row, and each fixed-point variant's step of the period budget \
+             above (`step NAME`, on its step scene), run again with its stages marked (`sonolube::stage`: \
+             `ClosedLoop::control_phase_marked`, the same steps bit for bit; the firmware's step \
+             is the unmarked code), the instructions between two marks charged to the stage \
+             that ran, counted in QEMU as above (`bench stage NAME / STAGE`), per step. Each \
+             interval also holds one mark's own cost, measured on 4,096 back-to-back marks and \
+             taken off. *script*: the simulation's target schedule and bookkeeping around the \
+             firmware's step; *resonance*: the drive current's samples and the resonance loop's \
+             hold on the command; *sensing*: both load cells' codes to newtons; *estimator*: \
+             the filtered load, friction, speed and coefficient; *supervision*: faults, sliding \
+             detection, learning mu0, the state machine, the ramps, the output record; *model*: \
+             the operating point and F'/F at the applied drive; *inverse*: the amplitude for the \
+             commanded ratio; *feedback*: the target's ratio, the prediction's filters, the PI \
+             and the net-force hold; *shaper*: slew, soft start, envelope. *outside the stages*: \
+             the whole step (unmarked, the rows above) less the sum (the call into the phase, and \
+             code the marks made the compiler lay out differently):\n"
+        );
+        self.stage_breakdown(&mut s);
         s.push('\n');
         let _ = writeln!(
             s,

@@ -2,12 +2,14 @@
 //!
 //! The firmware prints one line per measurement (`board/qemu/src/bench.rs`):
 //! `bench NAME: N.NNN instructions per call (C calls[, longest L])`, after defmt-print's
-//! timestamp and level; the table variants' builds as `bench build NAME: ...`. Other lines
+//! timestamp and level; the table variants' builds as `bench build NAME: ...`, the stages of
+//! a control-step row as `bench stage NAME / STAGE: ...`. Other lines
 //! are ignored. A name printed twice is an error, and so is a
 //! catalogued variant or control step without a count (the log is from another build).
 
 use std::collections::BTreeMap;
 
+use sonolube::stage::Stage;
 use sonolube::variant::budget::step_scene;
 use sonolube::variant::{CATALOGUE, CONTROL_STEPS};
 
@@ -106,6 +108,30 @@ pub fn build_name(variant: &str) -> String {
     format!("build {variant}")
 }
 
+/// The name of one stage's count in a control-step row's breakdown (`bench stage STEP /
+/// STAGE`, `sonolube::stage`).
+pub fn stage_name(step: &str, stage: Stage) -> String {
+    format!("stage {step} / {}", stage.name())
+}
+
+/// Every control step broken down by stage: the control-step rows, then the variants' steps
+/// (`step NAME`).
+pub fn staged_steps() -> Vec<String> {
+    CONTROL_STEPS
+        .iter()
+        .map(|c| c.0.to_string())
+        .chain(step_names())
+        .collect()
+}
+
+/// Names of every stage count of [`staged_steps`].
+pub fn stage_names() -> Vec<String> {
+    staged_steps()
+        .iter()
+        .flat_map(|step| Stage::ALL.iter().map(|&stage| stage_name(step, stage)))
+        .collect()
+}
+
 /// Every count of a log. Errors: a malformed benchmark line, a name twice, or a catalogued
 /// variant or control step missing.
 pub fn parse(log: &str) -> Result<Counts, String> {
@@ -124,12 +150,14 @@ pub fn parse(log: &str) -> Result<Counts, String> {
         .map(table_count_name)
         .collect();
     let steps = step_names();
+    let stages = stage_names();
     let expected = CATALOGUE
         .iter()
         .map(|v| v.name)
         .chain(CONTROL_STEPS.iter().map(|c| c.0))
         .chain(builds.iter().map(String::as_str))
-        .chain(steps.iter().map(String::as_str));
+        .chain(steps.iter().map(String::as_str))
+        .chain(stages.iter().map(String::as_str));
     let missing: Vec<&str> = expected.filter(|n| !counts.contains_key(*n)).collect();
     if !missing.is_empty() {
         return Err(format!(
@@ -169,6 +197,11 @@ mod tests {
                 "1.1 INFO  bench {name}: 2764.320 instructions per call (250 calls, longest 3040)\n"
             ));
         }
+        for name in stage_names() {
+            log.push_str(&format!(
+                "1.2 INFO  bench {name}: 300.500 instructions per call (250 calls)\n"
+            ));
+        }
         log
     }
 
@@ -179,7 +212,20 @@ mod tests {
         assert!(tables > 0);
         assert_eq!(
             counts.len(),
-            CATALOGUE.len() + CONTROL_STEPS.len() + tables + step_names().len()
+            CATALOGUE.len()
+                + CONTROL_STEPS.len()
+                + tables
+                + step_names().len()
+                + (CONTROL_STEPS.len() + step_names().len()) * Stage::ALL.len()
+        );
+        let name = stage_name(&step_name("Dahl steady T=49x73"), Stage::Inverse);
+        assert_eq!(name, "stage step Dahl steady T=49x73 / inverse");
+        assert!(counts.contains_key(&name));
+        let no_stage = full_log().replace("bench stage control step / inverse:", "bench other:");
+        assert!(
+            parse(&no_stage)
+                .unwrap_err()
+                .contains("stage control step / inverse")
         );
         assert_eq!(counts["build cube ep T=17x17"].calls, 3);
         let no_build = full_log().replace("bench build cube ep T=9x9:", "bench other:");
