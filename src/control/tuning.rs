@@ -119,7 +119,10 @@ pub fn soft_start_full_scale_s(envelope_time_constant_s: f64, baseline_s: f64) -
 
 /// The response time constant of the drive's lead, s: one control period `period_s` when the
 /// scene's steps are staged (an overshoot criterion, `step_overshoot` `Some`), otherwise
-/// `unstaged_s` (the baseline's 0.25 ms, at most the envelope's).
+/// `unstaged_s` (the baseline's 0.25 ms, at most the envelope's). Never faster than the lead's
+/// Q8.24 gain allows on the envelope `envelope_s` (a gain below [`MAX_STAGED_LEAD_GAIN`]: a
+/// very slow envelope, Q above about 1,250 at 20 kHz, gets a slower lead rather than a refusal),
+/// and never slower than `unstaged_s`.
 ///
 /// The lead makes the envelope follow the desired amplitude as a first-order lag of this time
 /// constant (`control/shaper.rs`). It used to be the overshoot bound: a plant that reduces
@@ -139,12 +142,27 @@ pub fn staged_response_time_constant_s(
     step_overshoot: Option<f64>,
     period_s: f64,
     unstaged_s: f64,
+    envelope_s: f64,
 ) -> f64 {
     match step_overshoot {
-        Some(_) if period_s > 0.0 && period_s.is_finite() => libm::fmin(period_s, unstaged_s),
+        Some(_) if period_s > 0.0 && period_s.is_finite() && envelope_s > 0.0 => {
+            // The lead gain is alpha(tau_r) / alpha(tau_env), alpha(tau) = 1 - e^(-T / tau).
+            let envelope_alpha = -libm::expm1(-period_s / envelope_s);
+            let largest_alpha = MAX_STAGED_LEAD_GAIN * envelope_alpha;
+            let fastest = if largest_alpha < 1.0 {
+                -period_s / libm::log1p(-largest_alpha)
+            } else {
+                0.0
+            };
+            libm::fmin(libm::fmax(period_s, fastest), unstaged_s)
+        }
         _ => unstaged_s,
     }
 }
+
+/// The largest lead gain a staged step's lead is given: below the Q8.24 format's 128 with a
+/// margin for its rounding.
+pub const MAX_STAGED_LEAD_GAIN: f64 = 127.0;
 
 /// The tightest overshoot criterion of `scene`, as a fraction of the step; `None` without one.
 pub fn overshoot_criterion(scene: &Scene<'_>) -> Option<f64> {
@@ -444,6 +462,7 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
             step_overshoot,
             settings.period_s,
             settings.response_time_constant_s,
+            envelope,
         ),
         ..settings
     };
@@ -635,23 +654,25 @@ mod tests {
         let stage = config.stage.expect("staged");
         assert!((stage.lead().to_f64() - 1.05 / 1.2).abs() < 1e-9);
         // No criterion: the whole step at once, the baseline's lead (at most the envelope).
-        assert_eq!(
-            staged_response_time_constant_s(None, 1e-4, 0.25e-3),
-            0.25e-3
-        );
-        assert_eq!(
-            staged_response_time_constant_s(Some(0.05), 1e-4, 0.25e-3),
-            1e-4
-        );
+        let env = s.envelope_time_constant_s;
+        let lead = |o: Option<f64>, period: f64, envelope: f64| {
+            staged_response_time_constant_s(o, period, 0.25e-3, envelope)
+        };
+        assert_eq!(lead(None, 1e-4, env), 0.25e-3);
+        assert_eq!(lead(Some(0.05), 1e-4, env), 1e-4);
         // A period longer than the unstaged lead keeps the unstaged lead; bad input too.
-        assert_eq!(
-            staged_response_time_constant_s(Some(0.05), 1e-3, 0.25e-3),
-            0.25e-3
-        );
-        assert_eq!(
-            staged_response_time_constant_s(Some(0.05), f64::NAN, 0.25e-3),
-            0.25e-3
-        );
+        assert_eq!(lead(Some(0.05), 1e-3, env), 0.25e-3);
+        assert_eq!(lead(Some(0.05), f64::NAN, env), 0.25e-3);
+        assert_eq!(lead(Some(0.05), 1e-4, 0.0), 0.25e-3);
+        // A very slow envelope (Q 2000 at 20 kHz, 31.8 ms) gets the lead whose gain is 127,
+        // which the shaper accepts, where one period's gain (200) it would refuse.
+        let slow = 2_000.0 / (core::f64::consts::PI * 20e3);
+        let tau = lead(Some(0.05), 1e-4, slow);
+        assert!(tau > 1e-4 && tau < 0.25e-3, "{tau}");
+        let gain = (-1e-4 / tau).exp_m1() / (-1e-4 / slow).exp_m1();
+        assert!((gain - MAX_STAGED_LEAD_GAIN).abs() < 1e-6, "{gain}");
+        assert!(crate::control::ShaperConfig::new(slow, tau, 0.5e-3, 1e-4).is_ok());
+        assert!(crate::control::ShaperConfig::new(slow, 1e-4, 0.5e-3, 1e-4).is_err());
         let unstaged = Settings {
             step_overshoot: None,
             ..s
