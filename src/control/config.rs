@@ -13,6 +13,7 @@ use super::pi::{GainsError, PiGains};
 use super::schedule::GainSchedule;
 use super::shaper::{ShaperConfig, ShaperError};
 use super::sliding::SlidingConfig;
+use super::stage::StageConfig;
 use super::supervisor::RampConfig;
 use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
 
@@ -100,6 +101,10 @@ pub struct Settings {
     /// The load the noise is referred to, N: the lightest load the rig runs at (where the
     /// cells' noise is largest against the forces). Only the tuning rule reads it.
     pub design_load_n: f64,
+    /// The overshoot a target step may reach, fraction of the step, with a plant off the model
+    /// by `model_mismatch`: the feedforward of each step is staged so that it cannot pass it
+    /// (`control/stage.rs`); `None`: the whole step at once.
+    pub step_overshoot: Option<f64>,
 }
 
 impl Settings {
@@ -145,6 +150,7 @@ impl Settings {
         tangential_noise_n: 0.01,
         model_mismatch: 0.2,
         design_load_n: 4.0,
+        step_overshoot: None,
     };
 }
 
@@ -209,6 +215,8 @@ pub struct Config {
     pub(super) contact_lag: Option<LowPassCoef>,
     pub(super) ramp: RampConfig,
     pub(super) gains: GainSchedule,
+    /// The staging of a target step's feedforward; `None`: the whole step at once.
+    pub(super) stage: Option<StageConfig>,
     pub(super) limit: AmplitudeLimit,
     /// The ratings `limit` was computed from, kept for [`Config::at_drive_frequency`].
     pub(super) actuator: ActuatorRatings,
@@ -356,6 +364,10 @@ impl Config {
                 down_step: step(s.ramp_down_full_scale_s, "ramp_down_full_scale_s")?,
             },
             gains: gain_schedule(s)?,
+            stage: match s.step_overshoot {
+                Some(overshoot) => StageConfig::new(overshoot, s.model_mismatch)?,
+                None => None,
+            },
             limit: AmplitudeLimit::new(&s.actuator).map_err(ConfigError::Limits)?,
             actuator: s.actuator,
         })

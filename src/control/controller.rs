@@ -13,6 +13,7 @@ use super::recip::Reciprocal;
 use super::schedule::{Boost, GainSchedule};
 use super::shaper::{DriveRequest, DriveShaper};
 use super::sliding::SlidingDetector;
+use super::stage::StepStage;
 use super::supervisor::{Contact, Supervisor};
 use super::target::PreparedTarget;
 use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
@@ -145,6 +146,8 @@ pub struct ControllerState {
     /// ([`Controller::drive_replaced`]); back to `None` once it has decayed to
     /// `natural_max_drive`.
     external_drive: ExternalDrive,
+    /// The staging of the present target step's feedforward (`control/stage.rs`).
+    stage: StepStage,
 }
 
 /// The friction controller: configuration plus state.
@@ -194,6 +197,7 @@ impl Controller {
                 target: None,
                 coulomb: (Q2_30::ZERO, Q2_30::ZERO, 1 << 30),
                 external_drive: ExternalDrive::None,
+                stage: StepStage::new(),
             },
             config,
         }
@@ -333,6 +337,7 @@ impl Controller {
             self.state.prediction_valid = false;
             self.state.feedforward = Q1_31::ZERO;
             self.state.boost.restart();
+            self.state.stage.restart();
         }
     }
 
@@ -398,6 +403,8 @@ impl Controller {
                 Some(lag) => lag.process(&mut s.sensed_prediction, predicted_now),
                 None => predicted_now,
             };
+            // The filtered prediction before this step: where a staged step begins.
+            let before = s.prediction.output();
             let predicted = c.estimator.tangential.process(&mut s.prediction, sensed);
             let reference = predicted.saturating_sub(s.pi.correction()).value;
             let error = reference.saturating_sub(measured).value;
@@ -406,10 +413,12 @@ impl Controller {
             s.pi.retune(&s.gains, &gains);
             s.gains = gains;
             let candidate = s.pi.candidate(&gains, error);
-            let command = target_ratio
-                .value
-                .saturating_add(candidate.correction())
-                .value;
+            // The feedforward's target: the step staged by the declared mismatch.
+            let feedforward = match &c.stage {
+                Some(stage) => stage.staged(&mut s.stage, target_ratio.value, before, predicted),
+                None => target_ratio.value,
+            };
+            let command = feedforward.saturating_add(candidate.correction()).value;
             marks.enter(Stage::Inverse);
             let inversion = model.invert_from(&point, command.max(Q2_30::ZERO), s.feedforward)?;
             marks.enter(Stage::Feedback);
@@ -512,6 +521,7 @@ impl Controller {
             PreparedTarget::new(&target).ok_or(ControlError::InvalidTarget { target })?;
         if self.state.target.map(|(t, _)| t) != Some(target) {
             self.state.boost.restart();
+            self.state.stage.restart();
         }
         self.state.target = Some((target, prepared));
         Ok(())

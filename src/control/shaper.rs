@@ -27,6 +27,9 @@ pub struct ShaperConfig {
     envelope: LowPassCoef,
     lead_gain: Q8_24,
     slew_step: Q1_31,
+    /// `2 s (1 - alpha_env) / alpha_env` (`s` the slew step), Q8.24 in [0, 128): the braking
+    /// bound's coefficient ([`ShaperConfig::braking_excess`]).
+    brake: Q8_24,
 }
 
 /// Why the shaping settings were refused.
@@ -60,11 +63,41 @@ impl ShaperConfig {
         let lead_gain = Q8_24::from_f64(gain).map_err(|_| ShaperError::OutOfRange)?;
         let step = (period_s / slew_full_scale_s).min(1.0);
         let slew_step = Q1_31::from_f64_saturating(step).value.max(Q1_31::ULP);
+        // Below 128: beyond it the bound exceeds full scale for every gap above 2^-7 anyway
+        // (sqrt(128 d) > 1), so the largest Q8.24 value is taken there.
+        let alpha = envelope.alpha().to_f64();
+        let brake =
+            Q8_24::from_f64_saturating(2.0 * slew_step.to_f64() * (1.0 - alpha) / alpha).value;
         Ok(Self {
             envelope,
             lead_gain,
             slew_step,
+            brake,
         })
+    }
+
+    /// The most the command may pass the desired amplitude while the envelope is `gap` (Q1.31,
+    /// at least 0) short of it, so that the slew limit can still bring the command back before the
+    /// envelope passes the desired amplitude: `sqrt(h^2 + 2 s (1 - alpha) / alpha d) - h`, `h =
+    /// d + s / 2`.
+    ///
+    /// Why: the lead's command is `a_env + g (a_des - a_env)`; with a large `g` (a slow envelope
+    /// against a fast lead) it lies far above `a_des`, and coming down costs `n = (u - a_des) /
+    /// s` steps at the slew step `s`, over which the envelope keeps rising by `alpha (u_j -
+    /// a_env)` a step. With `w = u - a_des` and `d = a_des - a_env`, and the envelope taken as
+    /// standing still (an upper bound), the rise over the `n + 1` steps `u, u - s, ..., a_des`
+    /// is at most `alpha (w / s + 1) (w / 2 + d)`; it stays within `d` for `w^2 + (s + 2 d) w -
+    /// 2 s d (1 / alpha - 1) <= 0`. Without the bound a 60 kHz, Q 200 transducer (g 7 with a
+    /// lead of one period) overshot its 30 % step by 20 %.
+    pub fn braking_excess(&self, gap: Q1_31) -> Q1_31 {
+        // In units of 2^-23 (d, h < 2^24): 4 h^2 + 2 b d < 2^50 + 2^55, its root in units of
+        // 2^-24, below 2^28, shifted to Q1.31 below 2^35: taken at most full scale.
+        let d = (gap.to_bits().max(0) as u64) >> 8;
+        let h = d + ((self.slew_step.to_bits().max(0) as u64) >> 9);
+        let b = self.brake.to_bits().max(0) as u64;
+        let root = u64::from(crate::fx::isqrt_u64(4 * h * h + 2 * b * d));
+        let excess = ((root << 7) as i64 - ((h << 8) as i64)).clamp(0, i32::MAX as i64);
+        Q1_31::from_bits(excess as i32)
     }
 
     /// The envelope model's coefficient `1 - exp(-T / tau_env)`.
@@ -165,6 +198,14 @@ impl SampleBlock<DriveRequest> for ShaperConfig {
         // (desired - envelope) in (-2^31, 2^31) times g < 2^31: below 2^62.
         let push = (request.desired.to_bits() as i64 - envelope) * self.lead_gain.to_bits() as i64;
         let lead = envelope + ((push + (1 << 23)) >> 24);
+        // No more overdrive than the slew limit can take back before the envelope passes the
+        // desired amplitude ([`ShaperConfig::braking_excess`]), either way.
+        let desired = request.desired.to_bits() as i64;
+        let gap = Q1_31::from_bits((desired - envelope).abs().min(i32::MAX as i64) as i32);
+        let excess = self.braking_excess(gap).to_bits() as i64;
+        let lead = lead
+            .min(desired.max(envelope) + excess)
+            .max(desired.min(envelope) - excess);
         let previous = shaper.command.to_bits() as i64;
         let step = self.slew_step.to_bits() as i64;
         // max/min, not clamp: no panic path in the binary.
@@ -288,6 +329,45 @@ mod tests {
             shaper.apply(&cfg, Q1_31::ZERO);
         }
         assert_eq!(shaper.envelope(), Q1_31::ZERO);
+    }
+
+    #[test]
+    fn the_overdrive_stops_where_the_slew_limit_can_still_take_it_back() {
+        // 60 kHz, Q 200 (tau_env 1.06 ms), a lead of one period (g 7.0), full scale slewed
+        // in 0.5 ms: the step to 0.3 must not carry the envelope past 0.3. Without the
+        // braking bound the command sat at full scale and came down 0.2 a step too late: the
+        // envelope reached 0.325.
+        let cfg = ShaperConfig::new(1.061e-3, 1e-4, 0.5e-3, T).unwrap();
+        assert!(
+            (cfg.lead_gain().to_f64() - 6.99).abs() < 0.05,
+            "{:?}",
+            cfg.lead_gain()
+        );
+        let mut shaper = DriveShaper::new();
+        let mut peak = 0.0f64;
+        for _ in 0..100 {
+            cfg.process(
+                &mut shaper,
+                DriveRequest {
+                    desired: a(0.3),
+                    ceiling: a(0.999),
+                },
+            );
+            peak = peak.max(shaper.envelope().to_f64());
+        }
+        assert!(peak <= 0.3 + 1e-6, "{peak}");
+        assert!((shaper.envelope().to_f64() - 0.3).abs() < 1e-4);
+        // The bound: sqrt(h^2 + 2 s (1 - alpha) / alpha d) - h, h = d + s / 2; 0 with no
+        // gap, and never negative.
+        let alpha = cfg.envelope().alpha().to_f64();
+        let (d, s) = (0.1, 0.2);
+        let h = d + s / 2.0;
+        let want = (h * h + 2.0 * s * (1.0 - alpha) / alpha * d).sqrt() - h;
+        let got = cfg.braking_excess(a(d)).to_f64();
+        assert!((got - want).abs() < 1e-5, "{got} {want}");
+        assert_eq!(cfg.braking_excess(Q1_31::ZERO), Q1_31::ZERO);
+        assert_eq!(cfg.braking_excess(Q1_31::from_bits(-5)), Q1_31::ZERO);
+        assert!(cfg.braking_excess(Q1_31::MAX).to_f64() > 0.0);
     }
 
     #[test]

@@ -117,41 +117,52 @@ pub fn soft_start_full_scale_s(envelope_time_constant_s: f64, baseline_s: f64) -
     }
 }
 
-/// The shortest response time constant of the drive's lead, s, at which a plant that reduces
-/// the friction `1 + m` times as much as the model (`m` the declared mismatch) overshoots a
-/// target step by at most the fraction `overshoot` of the step; `baseline_s` (the lead's
-/// 0.25 ms) when no bound is asked (`None`) or needed (`m <= overshoot`).
+/// The response time constant of the drive's lead, s: one control period `period_s` when the
+/// scene's steps are staged (an overshoot criterion, `step_overshoot` `Some`), otherwise
+/// `unstaged_s` (the baseline's 0.25 ms, at most the envelope's). Never faster than the lead's
+/// Q8.24 gain allows on the envelope `envelope_s` (a gain below [`MAX_STAGED_LEAD_GAIN`]: a
+/// very slow envelope, Q above about 1,250 at 20 kHz, gets a slower lead rather than a refusal),
+/// and never slower than `unstaged_s`.
 ///
-/// The lead makes the envelope follow the desired amplitude as a first-order lag of time
-/// constant `tau_r` (`control/shaper.rs`), so the plant's friction moves by `(1 + m) (1 -
-/// e^(-t / tau_r))` of the step while the model error is on its way to the PI through the
-/// stages after the friction (the cell and the force filter: `delay_s`, taken as a dead time,
-/// which no feedback shortens; a compliant contact's relaxation lies before the friction and
-/// only slows its approach further). Once it arrives the correction follows it, so
-/// the friction is `x(t) + m (x(t) - x(t - delay))`, whose peak, at `t = delay`, passes the
-/// target by `m - (1 + m) e^(-delay / tau_r)` of the step. It stays within `overshoot` for
-/// `tau_r >= delay / ln((1 + m) / (m - overshoot))`. Reference: delay 0.716 ms (79.6 us +
-/// 0.637 ms), m 0.2, 5 %: ln 8 = 2.08, tau_r >= 0.344 ms (the baseline's 0.25 ms
-/// lets the peak reach 11 % of the step in this model; a plant near the mismatch grid's mu
-/// x1.3 k_t x2 corner overshot 5.0-6.7 %, docs/control-and-scenes.md).
-pub fn overshoot_bounded_response_s(
-    delay_s: f64,
-    mismatch: f64,
-    overshoot: Option<f64>,
-    baseline_s: f64,
+/// The lead makes the envelope follow the desired amplitude as a first-order lag of this time
+/// constant (`control/shaper.rs`). It used to be the overshoot bound: a plant that reduces
+/// `1 + m` times as much as the model moves the friction by `(1 + m) (1 - e^(-t / tau_r))` of
+/// the step while the model error is still on its way to the PI through the cell and the force
+/// filter (`delay`, 0.716 ms on the reference), and with the correction following it from then
+/// on the peak passes the target by `m - (1 + m) e^(-delay / tau_r)`: `tau_r >= delay / ln((1 +
+/// m) / (m - o))`, 0.344 ms on the reference. That bounded the overshoot by slowing every step
+/// to about 4.5 `tau_r` (the reference's step settled in 1.7 ms median). The staged feedforward
+/// (`control/stage.rs`) bounds the same overshoot by what it asks, `x <= ((1 + o) + m z) / (1 +
+/// m)` with `z` the prediction's progress through those lags, whatever the envelope's pace; the
+/// envelope can then go as fast as the drive allows: one period is the fastest the loop can ask
+/// (the lead gain `(1 - e^-1) / (1 - e^(-T / tau_env))`, 5.4 at the reference), and the slew
+/// limit and the actuator's ceiling cut the overdrive (the envelope estimate follows what was
+/// applied). The caller keeps it at most the envelope's own time constant.
+pub fn staged_response_time_constant_s(
+    step_overshoot: Option<f64>,
+    period_s: f64,
+    unstaged_s: f64,
+    envelope_s: f64,
 ) -> f64 {
-    match overshoot {
-        Some(o) if o >= 0.0 && mismatch > o && delay_s > 0.0 => {
-            let bound = delay_s / libm::log((1.0 + mismatch) / (mismatch - o));
-            if bound.is_finite() {
-                libm::fmax(bound, baseline_s)
+    match step_overshoot {
+        Some(_) if period_s > 0.0 && period_s.is_finite() && envelope_s > 0.0 => {
+            // The lead gain is alpha(tau_r) / alpha(tau_env), alpha(tau) = 1 - e^(-T / tau).
+            let envelope_alpha = -libm::expm1(-period_s / envelope_s);
+            let largest_alpha = MAX_STAGED_LEAD_GAIN * envelope_alpha;
+            let fastest = if largest_alpha < 1.0 {
+                -period_s / libm::log1p(-largest_alpha)
             } else {
-                baseline_s
-            }
+                0.0
+            };
+            libm::fmin(libm::fmax(period_s, fastest), unstaged_s)
         }
-        _ => baseline_s,
+        _ => unstaged_s,
     }
 }
+
+/// The largest lead gain a staged step's lead is given: below the Q8.24 format's 128 with a
+/// margin for its rounding.
+pub const MAX_STAGED_LEAD_GAIN: f64 = 127.0;
 
 /// The tightest overshoot criterion of `scene`, as a fraction of the step; `None` without one.
 pub fn overshoot_criterion(scene: &Scene<'_>) -> Option<f64> {
@@ -441,19 +452,16 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
         design_load_n: scene.contents.load_min_n,
         ..reference
     };
-    // The lead no faster than a plant of the declared mismatch allows under the scene's
-    // overshoot criterion ([`overshoot_bounded_response_s`]), and never slower than the
-    // envelope itself.
-    let after_friction =
-        settings.sensor_lag_s + 1.0 / (core::f64::consts::TAU * settings.tangential_bandwidth_hz);
+    // A scene with an overshoot criterion stages each step's feedforward so that a plant of
+    // the declared mismatch cannot pass it ([`staged_response_time_constant_s`]), and the lead
+    // then asks the envelope for the staged amplitude within one control period.
+    let step_overshoot = overshoot_criterion(scene);
     let settings = Settings {
-        response_time_constant_s: libm::fmin(
-            overshoot_bounded_response_s(
-                after_friction,
-                settings.model_mismatch,
-                overshoot_criterion(scene),
-                settings.response_time_constant_s,
-            ),
+        step_overshoot,
+        response_time_constant_s: staged_response_time_constant_s(
+            step_overshoot,
+            settings.period_s,
+            settings.response_time_constant_s,
             envelope,
         ),
         ..settings
@@ -577,22 +585,22 @@ mod tests {
         assert_eq!(s.natural_prior_weight, NATURAL_PRIOR_WEIGHT);
         assert_eq!(s.sliding_debounce_s, SLIDING_DEBOUNCE_S);
         // The rule: kiT capped at 1 - 0.2 - 0.3 = 0.5 (the noise allows 38 000 /s), held for
-        // three lags of 0.344 ms + 1.1 us + 79.6 us + 0.637 ms.
+        // three lags of 0.1 ms + 1.1 us + 79.6 us + 0.637 ms.
         assert_eq!(s.kp_fast, 0.3);
         assert!(
             (s.ki_fast_per_s - 5_000.0).abs() < 1e-6,
             "{}",
             s.ki_fast_per_s
         );
-        // (three lags: the lead's 0.344 ms (its overshoot bound) + 1.09 us of contact, 0.2 x 4.155 N / (0.8 x 25 N/um x
-        // 0.038 m/s), + 79.6 us + 0.637 ms.)
+        // (three lags: the lead's 0.1 ms (one period: the step is staged) + 1.09 us of
+        // contact, 0.2 x 4.155 N / (0.8 x 25 N/um x 0.038 m/s), + 79.6 us + 0.637 ms.)
         assert!(
             (s.contact_lag_s - 1.093_6e-6).abs() < 1e-9,
             "{}",
             s.contact_lag_s
         );
         assert!(
-            (s.boost_hold_s - 3.0 * (0.344_4e-3 + 0.717_3e-3)).abs() < 1e-6,
+            (s.boost_hold_s - 3.0 * (0.1e-3 + 0.717_3e-3)).abs() < 1e-6,
             "{}",
             s.boost_hold_s
         );
@@ -629,67 +637,57 @@ mod tests {
         assert_eq!(soft_start_full_scale_s(f64::NAN, 5e-3), 5e-3);
     }
 
-    /// The peak overshoot, fraction of the step, of `y(t) = (1 + m) x(t)` before the dead time
-    /// `delay` and `x(t) + m (x(t) - x(t - delay))` after it, `x` the unit step through a
-    /// first-order lag `tau`: stepped in time (1 us) rather than taken from the closed form.
-    fn delayed_correction_peak(delay: f64, mismatch: f64, tau: f64) -> f64 {
-        let x = |t: f64| if t > 0.0 { 1.0 - (-t / tau).exp() } else { 0.0 };
-        (0..20_000)
-            .map(|k| {
-                let t = k as f64 * 1e-6;
-                let y = if t < delay {
-                    (1.0 + mismatch) * x(t)
-                } else {
-                    x(t) + mismatch * (x(t) - x(t - delay))
-                };
-                y - 1.0
-            })
-            .fold(0.0, f64::max)
-    }
-
     #[test]
-    fn the_lead_is_slowed_until_the_mismatch_cannot_overshoot() {
-        // The reference: 0.716 ms after the friction (the cell, the filter), m 0.2, 5 %:
-        // 0.344 ms.
-        let s = controller_settings(find("reference").expect("built in"));
-        let delay = s.sensor_lag_s + 1.0 / (core::f64::consts::TAU * s.tangential_bandwidth_hz);
-        assert!((delay - 0.716_2e-3).abs() < 1e-6, "{delay}");
-        let tau = overshoot_bounded_response_s(delay, 0.2, Some(0.05), 0.25e-3);
-        assert!((tau - delay / 8f64.ln()).abs() < 1e-12);
-        assert!((tau - 0.344_4e-3).abs() < 1e-6, "{tau}");
-        assert_eq!(s.response_time_constant_s, tau);
-        // At the bound the stepped model peaks at the criterion; the baseline's 0.25 ms, at 11 %.
-        let peak = delayed_correction_peak(delay, 0.2, tau);
-        assert!((peak - 0.05).abs() < 1e-3, "{peak}");
-        assert!(delayed_correction_peak(delay, 0.2, 0.25e-3) > 0.10);
-        // No criterion, or a mismatch the criterion already covers: the baseline.
-        assert_eq!(
-            overshoot_bounded_response_s(delay, 0.2, None, 0.25e-3),
-            0.25e-3
+    fn a_scene_with_an_overshoot_criterion_stages_its_steps_and_leads_in_one_period() {
+        // The reference (5 % overshoot): its steps staged at the declared 20 % mismatch, the
+        // lead at one 0.1 ms period (the first-order lead's overshoot bound gave 0.344 ms).
+        let scene = find("reference").expect("built in");
+        let s = controller_settings(scene);
+        assert_eq!(s.step_overshoot, Some(0.05));
+        assert_eq!(overshoot_criterion(scene), Some(0.05));
+        assert!(
+            (s.response_time_constant_s - 1e-4).abs() < 1e-15,
+            "{}",
+            s.response_time_constant_s
         );
-        assert_eq!(
-            overshoot_bounded_response_s(delay, 0.05, Some(0.05), 0.25e-3),
-            0.25e-3
+        let config = crate::control::Config::new(&s).expect("valid");
+        let stage = config.stage.expect("staged");
+        assert!((stage.lead().to_f64() - 1.05 / 1.2).abs() < 1e-9);
+        // No criterion: the whole step at once, the baseline's lead (at most the envelope).
+        let env = s.envelope_time_constant_s;
+        let lead = |o: Option<f64>, period: f64, envelope: f64| {
+            staged_response_time_constant_s(o, period, 0.25e-3, envelope)
+        };
+        assert_eq!(lead(None, 1e-4, env), 0.25e-3);
+        assert_eq!(lead(Some(0.05), 1e-4, env), 1e-4);
+        // A period longer than the unstaged lead keeps the unstaged lead; bad input too.
+        assert_eq!(lead(Some(0.05), 1e-3, env), 0.25e-3);
+        assert_eq!(lead(Some(0.05), f64::NAN, env), 0.25e-3);
+        assert_eq!(lead(Some(0.05), 1e-4, 0.0), 0.25e-3);
+        // A very slow envelope (Q 2000 at 20 kHz, 31.8 ms) gets the lead whose gain is 127,
+        // which the shaper accepts, where one period's gain (200) it would refuse.
+        let slow = 2_000.0 / (core::f64::consts::PI * 20e3);
+        let tau = lead(Some(0.05), 1e-4, slow);
+        assert!(tau > 1e-4 && tau < 0.25e-3, "{tau}");
+        let gain = (-1e-4 / tau).exp_m1() / (-1e-4 / slow).exp_m1();
+        assert!((gain - MAX_STAGED_LEAD_GAIN).abs() < 1e-6, "{gain}");
+        assert!(crate::control::ShaperConfig::new(slow, tau, 0.5e-3, 1e-4).is_ok());
+        assert!(crate::control::ShaperConfig::new(slow, 1e-4, 0.5e-3, 1e-4).is_err());
+        let unstaged = Settings {
+            step_overshoot: None,
+            ..s
+        };
+        assert!(
+            crate::control::Config::new(&unstaged)
+                .expect("valid")
+                .stage
+                .is_none()
         );
-        // A bound faster than the baseline keeps the baseline.
-        assert_eq!(
-            overshoot_bounded_response_s(1e-5, 0.2, Some(0.05), 0.25e-3),
-            0.25e-3
-        );
-        // Bad input: the baseline, no panic.
-        assert_eq!(
-            overshoot_bounded_response_s(f64::NAN, 0.2, Some(0.05), 0.25e-3),
-            0.25e-3
-        );
-        assert_eq!(
-            overshoot_bounded_response_s(delay, 0.2, Some(-1.0), 0.25e-3),
-            0.25e-3
-        );
-        // The scene's tightest overshoot criterion.
-        assert_eq!(
-            overshoot_criterion(find("reference").expect("built in")),
-            Some(0.05)
-        );
+        let bad = Settings {
+            step_overshoot: Some(f64::NAN),
+            ..s
+        };
+        assert!(crate::control::Config::new(&bad).is_err());
     }
 
     #[test]
