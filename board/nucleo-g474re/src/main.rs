@@ -40,6 +40,7 @@ mod ext_adc;
 mod overcurrent;
 mod rig;
 mod safe;
+mod scene_record;
 mod scene_start;
 mod sense_task;
 mod sensing;
@@ -207,8 +208,8 @@ struct Settings {
 #[embassy_executor::task]
 async fn control_task(settings: Settings) {
     let first = cells::first().await;
-    let rig = match sonolube::scene::builtin::find(DEFAULT_SCENE) {
-        Some(scene) => BoardRig::new(scene, first).map_err(|refusal| (scene.name, refusal)),
+    let rig = match scene_start::find(DEFAULT_SCENE) {
+        Some(scene) => BoardRig::new(scene, first).map_err(|refusal| (scene, refusal)),
         None => {
             defmt::error!("no scene named {=str}", DEFAULT_SCENE);
             return;
@@ -216,11 +217,11 @@ async fn control_task(settings: Settings) {
     };
     let rig = match rig {
         Ok(rig) => rig,
-        Err((name, refusal)) => {
+        Err((scene, refusal)) => {
+            let name = scene.name;
             // The drive stays safe; the watchdog (started without steps) resets the board.
             // A scene refused for its control period: the selection line says by how much.
-            if let Some(selection) =
-                sonolube::scene::builtin::find(name).and_then(sonolube::scene::builtin::selection)
+            if let Some(selection) = scene.selection()
                 && selection.refused()
             {
                 defmt::error!("scene {=str}: controller {}", name, selection);
@@ -251,8 +252,8 @@ async fn control_task(settings: Settings) {
     defmt::info!(
         "control: scene {=str} at {=f64} Hz, drive {=f64} Hz, idle; cycles in {=u64} Hz",
         scene.name,
-        scene.control_rate_hz,
-        scene.transducer.drive_hz,
+        rig.inner().start().record.control_rate_hz,
+        scene.drive_hz,
         BoardRig::CYCLE_HZ
     );
     rig.inner().log_model();

@@ -31,7 +31,6 @@ use sonolube::control::{ExternalFault, Reason};
 use sonolube::drive::Frequency;
 use sonolube::protocol::{Axis, Command, DRIVE_FREQ, ProtocolError, SupervisorState, TokenText};
 use sonolube::resonance::LockState;
-use sonolube::scene::Scene;
 use sonolube::sense::{Calibration, SenseError, SensorChannel};
 use sonolube::station::{CellBench, MAX_CURRENT_SAMPLES, Sample, Station, StationError};
 use sonolube_app::control::ControlLoop;
@@ -40,6 +39,7 @@ use sonolube_app::snapshot::Snapshot;
 use crate::bridge::{Bridge, CONTROLS_BRIDGE, DriveRefusal};
 use crate::cells::{CellFeed, RawPair};
 use crate::current::RingReader;
+use crate::scene_start::{BoardScene, SceneStart};
 use crate::sensing::TRIGGERS_PER_TRIPLET;
 use crate::{config, current, drive, scene_start};
 
@@ -55,14 +55,16 @@ pub enum SceneRefusal {
     Drive(DriveRefusal),
     /// The board's load-cell calibration ([`config::LOAD_CELL_INTERNAL`]) is unusable.
     Cells(SenseError),
-    /// The scene is not one this build compiled in, so its model variant selection is not in
-    /// flash ([`sonolube::scene::builtin::selection`]); the board does not link the selection.
+    /// The scene's record, constants or model variant selection are not in flash
+    /// ([`crate::scene_start`], `sonolube::scene::builtin::SELECTIONS`); the board does not link
+    /// the selection.
     NotCompiled,
 }
 
 /// Everything that depends on the scene, built whole before it replaces the running one.
 struct Setup {
-    scene: &'static Scene<'static>,
+    scene: &'static BoardScene,
+    start: &'static SceneStart,
     station: Station,
     bridge: Bridge,
     sliding_velocity_m_per_s: f32,
@@ -73,37 +75,42 @@ impl Setup {
     /// Configuration (the model variant's selection from the measured table, `f64`, the
     /// model's tables), between two steps; its duration on silicon is unmeasured (an overrun is
     /// counted if it exceeds a period).
-    fn new(scene: &'static Scene<'static>) -> Result<Self, SceneRefusal> {
+    fn new(scene: &'static BoardScene) -> Result<Self, SceneRefusal> {
         let calibration = config::LOAD_CELL_INTERNAL
             .calibration()
             .map_err(SceneRefusal::Cells)?;
         // The cheap check first: a scene the bridge cannot drive builds no model.
-        let bridge = Bridge::for_scene(
-            scene.transducer.drive_hz,
-            scene.actuator.full_scale_voltage_v,
-        )
-        .map_err(SceneRefusal::Drive)?;
-        let hold = hold_steps(scene.control_rate_hz);
+        let bridge = Bridge::for_scene(scene.drive_hz, scene.full_scale_voltage_v)
+            .map_err(SceneRefusal::Drive)?;
+        // The record and the constants the build script wrote (scene_start.rs).
+        let start = scene.start.ok_or(SceneRefusal::NotCompiled)?;
+        let record = &start.record;
+        let hold = hold_steps(record.control_rate_hz);
         let channel = cell_channel(calibration, hold);
         // The selection the build script made (the one `Station::new` would make, tested in
         // `scene::builtin`): the selection code and the measured table stay out of flash.
-        let selection =
-            sonolube::scene::builtin::selection(scene).ok_or(SceneRefusal::NotCompiled)?;
-        // The settings the build script computed (`controller_settings`, scene_start.rs).
-        let start = scene_start::of(scene).ok_or(SceneRefusal::NotCompiled)?;
-        let mut station =
-            Station::with_selection(scene, start.settings, selection, channel, channel)
-                .map_err(SceneRefusal::Station)?;
+        let selection = scene.selection().ok_or(SceneRefusal::NotCompiled)?;
+        // The settings the build script computed (`controller_settings`), on the scene the
+        // record gives (the station reads nothing the record leaves out: build.rs checks it).
+        let mut station = Station::with_selection(
+            &record.scene(scene.name),
+            start.settings,
+            selection,
+            channel,
+            channel,
+        )
+        .map_err(SceneRefusal::Station)?;
         if current::running() {
             // ADC2 samples the drive current at the stepped phases: `freq auto` can run.
             station.enable_current_sense();
         }
-        let sliding_velocity_m_per_s = scene
+        let sliding_velocity_m_per_s = record
             .sliding_velocity_m_per_s
             .first()
             .map_or(0.0, |point| point.value as f32);
         Ok(Self {
             scene,
+            start,
             station,
             bridge,
             sliding_velocity_m_per_s,
@@ -147,7 +154,7 @@ pub struct BoardRig {
 
 impl BoardRig {
     /// The rig of `scene`, its first sample `first`, its drive timing written to TIM1.
-    pub fn new(scene: &'static Scene<'static>, first: RawPair) -> Result<Self, SceneRefusal> {
+    pub fn new(scene: &'static BoardScene, first: RawPair) -> Result<Self, SceneRefusal> {
         let mut setup = Setup::new(scene)?;
         setup.bridge.install();
         Ok(Self {
@@ -159,8 +166,13 @@ impl BoardRig {
     }
 
     /// The scene.
-    pub fn scene(&self) -> &'static Scene<'static> {
+    pub fn scene(&self) -> &'static BoardScene {
         self.setup.scene
+    }
+
+    /// The scene's record and scene-start constants.
+    pub fn start(&self) -> &'static SceneStart {
+        self.setup.start
     }
 
     /// The station, for the settings store (`settings_flash.rs`).
@@ -203,16 +215,14 @@ impl BoardRig {
                 state,
             });
         }
-        let Some(scene) = sonolube::scene::builtin::find(name.as_str()) else {
+        let Some(scene) = scene_start::find(name.as_str()) else {
             return Err(ProtocolError::UnknownScene { name });
         };
         match Setup::new(scene) {
             Ok(setup) => {
                 // What cannot work is refused before it runs (issue 26): the findings of
                 // `Station::feasibility`, computed by the build script (scene_start.rs).
-                let Some(start) = scene_start::of(scene) else {
-                    return Err(ProtocolError::UnknownScene { name });
-                };
+                let start = setup.start;
                 for finding in start.findings {
                     defmt::warn!("scene {=str}: {}", scene.name, finding);
                 }
@@ -232,8 +242,8 @@ impl BoardRig {
                 defmt::info!(
                     "scene {=str}: {=f64} Hz control, drive {=f64} Hz, set speed {=f32} m/s",
                     scene.name,
-                    scene.control_rate_hz,
-                    scene.transducer.drive_hz,
+                    start.record.control_rate_hz,
+                    scene.drive_hz,
                     self.setup.sliding_velocity_m_per_s
                 );
                 self.log_model();
@@ -378,7 +388,7 @@ impl ControlLoop for BoardRig {
 
     fn rate_hz(&self) -> u32 {
         // Scenes run at 1 to 100 kHz.
-        self.setup.scene.control_rate_hz as u32
+        self.setup.start.record.control_rate_hz as u32
     }
 
     fn step(&mut self) -> Option<Snapshot> {

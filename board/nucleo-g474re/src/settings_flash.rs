@@ -82,7 +82,7 @@ pub fn after_watchdog_reset() -> bool {
 
 /// Whether this firmware has a scene of this name.
 pub fn known_scene(name: &str) -> bool {
-    sonolube::scene::builtin::find(name).is_some()
+    crate::scene_start::find(name).is_some()
 }
 
 impl Persistent for BoardRig {
