@@ -357,7 +357,7 @@ impl Station {
             )
         {
             let amplitude = amplitude.min(self.controller.config().limit().max_amplitude);
-            output.amplitude = amplitude;
+            output.amplitude = Amplitude::from_command(amplitude);
             self.controller.drive_replaced(amplitude);
         }
         if let Some(resonance) = self.resonance.as_ref() {
@@ -373,11 +373,14 @@ impl Station {
                 // The search drives its own low amplitude; the friction loop waits (a
                 // pending `start`) or keeps its supervision while its command is replaced.
                 output.amplitude = if drive_allowed {
-                    resonance.search_amplitude().command()
+                    resonance.search_amplitude()
                 } else {
-                    Q1_31::ZERO
+                    Amplitude::ZERO
                 };
-                self.controller.drive_replaced(output.amplitude);
+                // The envelope estimate follows in the controller's Q1.31; a search at full
+                // scale is its largest value there (2^-31 low: the flag changes nothing).
+                self.controller
+                    .drive_replaced(output.amplitude.command().value);
             } else if self.start_pending {
                 self.start_pending = false;
                 // Locked: the friction loop starts at the found frequency, with the current
@@ -389,7 +392,7 @@ impl Station {
                 let _ = self.controller.start();
             }
         }
-        self.applied = Amplitude::from_command(output.amplitude);
+        self.applied = output.amplitude;
         self.commission_period(
             &mut output,
             normal_force,

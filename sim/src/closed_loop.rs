@@ -27,7 +27,7 @@ use sonolube::commission::{CommissionResult, commissioned_scene};
 use sonolube::control::{
     Controller, ExternalFault, Output, Reason, SensorFault, Settings, controller_settings,
 };
-use sonolube::fx::Q1_31;
+use sonolube::drive::Amplitude;
 use sonolube::model::AnyModel;
 use sonolube::protocol::{Axis, Command, ProtocolError, SupervisorState, Target, TargetRange};
 use sonolube::scene::{Breakpoint, Scene};
@@ -338,7 +338,8 @@ impl<'a> ClosedLoop<'a> {
         let truth = &readings.truth;
         let judged = truth.target.map(|target| Judged::new(&target, truth));
         let ceiling = self.station.controller().config().limit().max_amplitude;
-        let at_limit = output.amplitude > Q1_31::ZERO && output.amplitude >= ceiling;
+        let at_limit =
+            output.amplitude > Amplitude::ZERO && output.amplitude.command().value >= ceiling;
         let observation = Observation {
             step: readings.step,
             time_s: truth.time_s,
@@ -347,7 +348,7 @@ impl<'a> ClosedLoop<'a> {
             at_limit,
             load_ramping: ramping(self.scene.normal_load_n, truth.time_s),
             state: output.state,
-            drive_zero: output.amplitude == Q1_31::ZERO,
+            drive_zero: output.amplitude == Amplitude::ZERO,
         };
         if self.mode == Mode::Scripted {
             self.judge.observe(&observation);
