@@ -287,17 +287,17 @@ fn log_timing(timing: &DriveTiming) {
     defmt::info!(
         "drive: at amplitude {=u32}/1024, CH1 high {=u32} ns, CH1N high {=u32} ns per period; \
          pulses vanish below amplitude {=u32}/1024",
-        amplitude.bits() >> 20,
+        amplitude.bits() >> 21,
         timing.high_side_on_ns(amplitude),
         timing.low_side_on_ns(amplitude),
-        timing.min_effective_amplitude().bits() >> 20
+        timing.min_effective_amplitude().bits() >> 21
     );
     // The ratings' ceiling at this frequency (f64 once, at configuration).
     match DriveLimits::new(&config::STACK, config::FULL_SCALE_V) {
         Ok(limits) => defmt::info!(
             "drive: amplitude ceiling {=u32}/1024 at this frequency (stack 15.466 V, 1.75 A; \
              full scale {=u32} mV); at full scale CH1 high {=u32} ns",
-            limits.max_amplitude(timing.frequency()).bits() >> 20,
+            limits.max_amplitude(timing.frequency()).bits() >> 21,
             (config::FULL_SCALE_V * 1000.0) as u32,
             timing.high_side_on_ns(Amplitude::FULL)
         ),
