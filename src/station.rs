@@ -36,7 +36,7 @@ use core::fmt::Write;
 use crate::protocol::DRIVE_FREQ;
 use crate::protocol::{Axis, Command, ProtocolError, SupervisorState, TareAxes, TokenText};
 use crate::scene::Scene;
-use crate::sense::{SampleError, SensorChannel};
+use crate::sense::{AdcCode, SampleError, SensorChannel};
 use crate::variant::{Selection, select};
 
 mod commission;
@@ -53,9 +53,9 @@ mod reach;
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Sample {
     /// Normal-force converter code (the cell's converter format, see [`crate::sense`]).
-    pub normal_code: u16,
+    pub normal_code: AdcCode,
     /// Tangential-force converter code.
-    pub tangential_code: u16,
+    pub tangential_code: AdcCode,
     /// Sliding velocity, m/s, signed (measured, or the rig's set speed where it has no
     /// sensor); saturated to the Q8.24 range +-128 m/s.
     pub sliding_velocity_m_per_s: f32,
@@ -91,7 +91,7 @@ pub trait CellBench {
     /// `load_n` newtons (0 for `tare`; the known load for `cal`). A real board ignores
     /// `load_n`: the operator has put that load on the cell. Returns false when the cell
     /// could not be read.
-    fn burst(&mut self, axis: Axis, load_n: f32, codes: &mut [i32]) -> bool;
+    fn burst(&mut self, axis: Axis, load_n: f32, codes: &mut [AdcCode]) -> bool;
 }
 
 /// Lowest and highest drive frequency a `freq` command may set, cHz (the protocol's range).
@@ -583,8 +583,8 @@ impl Station {
             TareAxes::One(Axis::Tangential) => (false, true),
             TareAxes::All => (true, true),
         };
-        let mut normal_codes = [0i32; COMMISSIONING_SAMPLES];
-        let mut tangential_codes = [0i32; COMMISSIONING_SAMPLES];
+        let mut normal_codes = [AdcCode::default(); COMMISSIONING_SAMPLES];
+        let mut tangential_codes = [AdcCode::default(); COMMISSIONING_SAMPLES];
         if normal && !bench.burst(Axis::Normal, 0.0, &mut normal_codes) {
             return Err(cal_failed("normal cell unreadable"));
         }
@@ -622,7 +622,7 @@ impl Station {
         let load_n = load_mn as f64 / 1e3;
         let load =
             Q16_16::from_f64(load_n).map_err(|_| cal_failed("load beyond the Q16.16 span"))?;
-        let mut codes = [0i32; COMMISSIONING_SAMPLES];
+        let mut codes = [AdcCode::default(); COMMISSIONING_SAMPLES];
         if !bench.burst(axis, load_n as f32, &mut codes) {
             return Err(cal_failed("cell unreadable"));
         }
@@ -822,8 +822,12 @@ fn cal_failed(reason: &'static str) -> ProtocolError {
 
 /// One code through a channel: the force (zero on a fault) and the fault, as the controller
 /// names it. A code the converter cannot produce counts as out of range.
-fn sense(channel: &mut SensorChannel, code: u16, sensor: Sensor) -> (Q16_16, Option<SensorFault>) {
-    let kind = match channel.process(i32::from(code)) {
+fn sense(
+    channel: &mut SensorChannel,
+    code: AdcCode,
+    sensor: Sensor,
+) -> (Q16_16, Option<SensorFault>) {
+    let kind = match channel.process(code) {
         Ok(force) => return (force.value, None),
         Err(SampleError::Fault(fault)) => match fault {
             crate::sense::SensorFault::LowRail { .. }

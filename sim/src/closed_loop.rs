@@ -31,6 +31,7 @@ use sonolube::drive::Amplitude;
 use sonolube::model::AnyModel;
 use sonolube::protocol::{Axis, Command, ProtocolError, SupervisorState, Target, TargetRange};
 use sonolube::scene::{Breakpoint, Scene};
+use sonolube::sense::AdcCode;
 use sonolube::station::{CellBench, Sample, Station};
 
 /// One control step of a run, for plots, CSV files and checks.
@@ -457,7 +458,7 @@ struct SimulatedCells<'s, 'a> {
 }
 
 impl CellBench for SimulatedCells<'_, '_> {
-    fn burst(&mut self, axis: Axis, load_n: f32, codes: &mut [i32]) -> bool {
+    fn burst(&mut self, axis: Axis, load_n: f32, codes: &mut [AdcCode]) -> bool {
         let (cell, index) = match axis {
             Axis::Normal => (&self.scene.normal_cell, 2u64),
             Axis::Tangential => (&self.scene.tangential_cell, 3u64),
@@ -470,7 +471,7 @@ impl CellBench for SimulatedCells<'_, '_> {
         let mut noise = Gaussian::from_seed(seed);
         let mut sim = LoadCellSim::new(cell, 1e-4, load_n);
         for code in codes.iter_mut() {
-            *code = i32::from(sim.sample(&mut noise, None));
+            *code = sim.sample(&mut noise, None);
         }
         self.burst = self.burst.wrapping_add(1);
         true
