@@ -36,7 +36,7 @@ use core::fmt::Write;
 use crate::protocol::DRIVE_FREQ;
 use crate::protocol::{Axis, Command, ProtocolError, SupervisorState, TareAxes, TokenText};
 use crate::scene::Scene;
-use crate::sense::{SampleError, SensorChannel};
+use crate::sense::{AdcCode, SampleError, SensorChannel};
 use crate::stage::{Stage, StageMarks};
 use crate::variant::{Selection, select};
 
@@ -54,9 +54,9 @@ mod reach;
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Sample {
     /// Normal-force converter code (the cell's converter format, see [`crate::sense`]).
-    pub normal_code: u16,
+    pub normal_code: AdcCode,
     /// Tangential-force converter code.
-    pub tangential_code: u16,
+    pub tangential_code: AdcCode,
     /// Sliding velocity, m/s, signed (measured, or the rig's set speed where it has no
     /// sensor); saturated to the Q8.24 range +-128 m/s.
     pub sliding_velocity_m_per_s: f32,
@@ -92,7 +92,7 @@ pub trait CellBench {
     /// `load_n` newtons (0 for `tare`; the known load for `cal`). A real board ignores
     /// `load_n`: the operator has put that load on the cell. Returns false when the cell
     /// could not be read.
-    fn burst(&mut self, axis: Axis, load_n: f32, codes: &mut [i32]) -> bool;
+    fn burst(&mut self, axis: Axis, load_n: f32, codes: &mut [AdcCode]) -> bool;
 }
 
 /// Lowest and highest drive frequency a `freq` command may set, cHz (the protocol's range).
@@ -366,7 +366,7 @@ impl Station {
             )
         {
             let amplitude = amplitude.min(self.controller.config().limit().max_amplitude);
-            output.amplitude = amplitude;
+            output.amplitude = Amplitude::from_command(amplitude);
             self.controller.drive_replaced(amplitude);
         }
         marks.enter(Stage::Resonance);
@@ -383,11 +383,14 @@ impl Station {
                 // The search drives its own low amplitude; the friction loop waits (a
                 // pending `start`) or keeps its supervision while its command is replaced.
                 output.amplitude = if drive_allowed {
-                    resonance.search_amplitude().command()
+                    resonance.search_amplitude()
                 } else {
-                    Q1_31::ZERO
+                    Amplitude::ZERO
                 };
-                self.controller.drive_replaced(output.amplitude);
+                // The envelope estimate follows in the controller's Q1.31; a search at full
+                // scale is its largest value there (2^-31 low: the flag changes nothing).
+                self.controller
+                    .drive_replaced(output.amplitude.command().value);
             } else if self.start_pending {
                 self.start_pending = false;
                 // Locked: the friction loop starts at the found frequency, with the current
@@ -400,7 +403,7 @@ impl Station {
             }
         }
         marks.enter(Stage::Supervision);
-        self.applied = Amplitude::from_command(output.amplitude);
+        self.applied = output.amplitude;
         self.commission_period(
             &mut output,
             normal_force,
@@ -591,8 +594,8 @@ impl Station {
             TareAxes::One(Axis::Tangential) => (false, true),
             TareAxes::All => (true, true),
         };
-        let mut normal_codes = [0i32; COMMISSIONING_SAMPLES];
-        let mut tangential_codes = [0i32; COMMISSIONING_SAMPLES];
+        let mut normal_codes = [AdcCode::default(); COMMISSIONING_SAMPLES];
+        let mut tangential_codes = [AdcCode::default(); COMMISSIONING_SAMPLES];
         if normal && !bench.burst(Axis::Normal, 0.0, &mut normal_codes) {
             return Err(cal_failed("normal cell unreadable"));
         }
@@ -630,7 +633,7 @@ impl Station {
         let load_n = load_mn as f64 / 1e3;
         let load =
             Q16_16::from_f64(load_n).map_err(|_| cal_failed("load beyond the Q16.16 span"))?;
-        let mut codes = [0i32; COMMISSIONING_SAMPLES];
+        let mut codes = [AdcCode::default(); COMMISSIONING_SAMPLES];
         if !bench.burst(axis, load_n as f32, &mut codes) {
             return Err(cal_failed("cell unreadable"));
         }
@@ -830,8 +833,12 @@ fn cal_failed(reason: &'static str) -> ProtocolError {
 
 /// One code through a channel: the force (zero on a fault) and the fault, as the controller
 /// names it. A code the converter cannot produce counts as out of range.
-fn sense(channel: &mut SensorChannel, code: u16, sensor: Sensor) -> (Q16_16, Option<SensorFault>) {
-    let kind = match channel.process(i32::from(code)) {
+fn sense(
+    channel: &mut SensorChannel,
+    code: AdcCode,
+    sensor: Sensor,
+) -> (Q16_16, Option<SensorFault>) {
+    let kind = match channel.process(code) {
         Ok(force) => return (force.value, None),
         Err(SampleError::Fault(fault)) => match fault {
             crate::sense::SensorFault::LowRail { .. }

@@ -2,7 +2,8 @@
 //! telemetry report.
 
 use sonolube::control::Output;
-use sonolube::fx::{Q1_31, Q2_30, Q16_16};
+use sonolube::drive::Amplitude;
+use sonolube::fx::{Q2_30, Q16_16};
 use sonolube::protocol::{Lock, LoopReading, RunReach, StatusReport, Target, TelemetryRecord};
 
 /// The loop after a step.
@@ -148,8 +149,9 @@ fn newtons_to_mn(force: Q16_16) -> i32 {
 }
 
 /// Q1.31 amplitude [0, 1) to ppm, rounded.
-fn amplitude_ppm(amplitude: Q1_31) -> u32 {
-    unsigned(amplitude.round_scaled(1_000_000))
+fn amplitude_ppm(amplitude: Amplitude) -> u32 {
+    // Full scale is 1,000,000: fits.
+    u32::try_from(amplitude.round_scaled(1_000_000)).unwrap_or(u32::MAX)
 }
 
 /// A non-negative scaled value as a `u32`; negative values (which these quantities never

@@ -27,10 +27,11 @@ use sonolube::commission::{CommissionResult, commissioned_scene};
 use sonolube::control::{
     Controller, ExternalFault, Output, Reason, SensorFault, Settings, controller_settings,
 };
-use sonolube::fx::Q1_31;
+use sonolube::drive::Amplitude;
 use sonolube::model::AnyModel;
 use sonolube::protocol::{Axis, Command, ProtocolError, SupervisorState, Target, TargetRange};
 use sonolube::scene::{Breakpoint, Scene};
+use sonolube::sense::AdcCode;
 use sonolube::stage::{Stage, StageMarks};
 use sonolube::station::{CellBench, Sample, Station};
 
@@ -363,7 +364,8 @@ impl<'a> ClosedLoop<'a> {
         let truth = &readings.truth;
         let judged = truth.target.map(|target| Judged::new(&target, truth));
         let ceiling = self.station.controller().config().limit().max_amplitude;
-        let at_limit = output.amplitude > Q1_31::ZERO && output.amplitude >= ceiling;
+        let at_limit =
+            output.amplitude > Amplitude::ZERO && output.amplitude.command().value >= ceiling;
         let observation = Observation {
             step: readings.step,
             time_s: truth.time_s,
@@ -378,7 +380,7 @@ impl<'a> ClosedLoop<'a> {
             at_limit,
             load_ramping: ramping(self.scene.normal_load_n, truth.time_s),
             state: output.state,
-            drive_zero: output.amplitude == Q1_31::ZERO,
+            drive_zero: output.amplitude == Amplitude::ZERO,
         };
         if self.mode == Mode::Scripted {
             self.judge.observe(&observation);
@@ -487,7 +489,7 @@ struct SimulatedCells<'s, 'a> {
 }
 
 impl CellBench for SimulatedCells<'_, '_> {
-    fn burst(&mut self, axis: Axis, load_n: f32, codes: &mut [i32]) -> bool {
+    fn burst(&mut self, axis: Axis, load_n: f32, codes: &mut [AdcCode]) -> bool {
         let (cell, index) = match axis {
             Axis::Normal => (&self.scene.normal_cell, 2u64),
             Axis::Tangential => (&self.scene.tangential_cell, 3u64),
@@ -500,7 +502,7 @@ impl CellBench for SimulatedCells<'_, '_> {
         let mut noise = Gaussian::from_seed(seed);
         let mut sim = LoadCellSim::new(cell, 1e-4, load_n);
         for code in codes.iter_mut() {
-            *code = i32::from(sim.sample(&mut noise, None));
+            *code = sim.sample(&mut noise, None);
         }
         self.burst = self.burst.wrapping_add(1);
         true

@@ -14,7 +14,7 @@
 use crate::plant::{Gaussian, LoadCellSim};
 use sonolube::fx::Q16_16;
 use sonolube::scene::LoadCell;
-use sonolube::sense::SensorChannel;
+use sonolube::sense::{AdcCode, SensorChannel};
 
 use super::SimError;
 
@@ -69,9 +69,9 @@ pub fn commission(
     // A cell settled on its load: the substep only sets the filter, which does not move.
     let mut burst = |force_n: f32| {
         let mut cell_sim = LoadCellSim::new(cell, 1e-4, force_n);
-        let mut codes = [0i32; COMMISSIONING_SAMPLES];
+        let mut codes = [AdcCode::default(); COMMISSIONING_SAMPLES];
         for code in &mut codes {
-            *code = i32::from(cell_sim.sample(&mut noise, None));
+            *code = cell_sim.sample(&mut noise, None);
         }
         codes
     };
@@ -100,11 +100,7 @@ mod tests {
         let sum: f64 = (0..n)
             .map(|_| {
                 let code = sim.sample(&mut noise, None);
-                channel
-                    .process(i32::from(code))
-                    .expect("healthy")
-                    .value
-                    .to_f64()
+                channel.process(code).expect("healthy").value.to_f64()
             })
             .sum();
         sum / f64::from(n)

@@ -87,11 +87,23 @@ mod tests {
     fn the_nominal_calibration_reads_mid_scale_as_zero_and_the_top_code_as_full_scale() {
         let scene = find("reference").expect("built in");
         let mut channel = sensor_channel(&scene.tangential_cell).expect("channel");
-        let zero = channel.process(2048).expect("healthy").value.to_f64();
+        let zero = channel
+            .process(sonolube::sense::AdcCode::new(2048))
+            .expect("healthy")
+            .value
+            .to_f64();
         assert_eq!(zero, 0.0);
-        let high = channel.process(3072).expect("healthy").value.to_f64();
+        let high = channel
+            .process(sonolube::sense::AdcCode::new(3072))
+            .expect("healthy")
+            .value
+            .to_f64();
         assert!((high - 1.0).abs() < 1e-4, "{high}");
-        assert!(channel.process(4095).is_err());
+        assert!(
+            channel
+                .process(sonolube::sense::AdcCode::new(4095))
+                .is_err()
+        );
         let huge = LoadCell {
             full_scale_n: 20_000.0,
             ..scene.tangential_cell

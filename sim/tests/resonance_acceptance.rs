@@ -82,7 +82,9 @@ impl Rig {
         let current_a = if self.connected { current_a } else { 0.0 };
         let code = 4096.0 * (0.5 + current_a / 6.6) + NOISE_LSB * self.noise.sample();
         let code = libm::roundf(code).clamp(0.0, 4095.0) as i32;
-        self.adc.normalize(code).unwrap()
+        self.adc
+            .normalize(sonolube::sense::AdcCode::new(code))
+            .unwrap()
     }
 
     /// One lock-in window at `tuning` and `amplitude`. The ADC is triggered from the drive's

@@ -17,7 +17,12 @@
 //!
 //! The blocks: [`super::LowPassCoef`] on [`super::LowPass`] (the filters),
 //! [`super::SlidingConfig`] on [`super::SlidingDetector`], [`super::ShaperConfig`] on
-//! [`super::DriveShaper`], [`super::GainSchedule`] on [`super::Boost`].
+//! [`super::DriveShaper`], [`super::GainSchedule`] on [`super::Boost`]; in the resonance
+//! loop, [`crate::resonance::Demodulator`] on [`crate::resonance::LockInSums`] (the lock-in,
+//! one current sample in, a window's phasor out at its end) and
+//! [`crate::resonance::TrackingLoop`] on [`crate::resonance::TrackerState`] (the PI tracker,
+//! one window in, one drive setting out). The search's sweep and the ring-down fit work once
+//! per window or per group, on the lock-in's output, not per sample: they stay step machines.
 
 /// A per-sample block of the control loop: `self` is its configuration, `state` what one
 /// sample changes.

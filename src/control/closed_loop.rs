@@ -214,7 +214,10 @@ fn unreachable_target_holds_full_drive_without_windup_and_recovers_cleanly() {
         if k > 50 {
             assert_eq!(out.reach, Some(Reach::BelowMinimum), "step {k}");
             assert!(out.saturation.model && out.saturation.integral_frozen);
-            assert_eq!(out.amplitude, ctl.config().limit().max_amplitude);
+            assert_eq!(
+                out.amplitude.command().value,
+                ctl.config().limit().max_amplitude
+            );
         }
         // The error stays near -0.075 (plant floor 0.434 against the model's 0.336) for the
         // whole 200 ms: integrating it would reach the limit (0.5) within 20 steps at the fast

@@ -464,7 +464,7 @@ impl Controller {
                 .map(|(_, t)| t.ratio(natural, s.estimate.normal_reciprocal).value)
         });
         Output {
-            amplitude: s.shaper.command(),
+            amplitude: crate::drive::Amplitude::from_command(s.shaper.command()),
             state: s.supervisor.state(),
             reason: s.supervisor.reason(),
             fault: s.supervisor.fault(),

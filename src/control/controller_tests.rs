@@ -8,6 +8,7 @@ use super::pi::PiGains;
 use super::reason::{ExternalFault, Reason, Sensor, SensorFault, SensorFaultKind};
 use super::schedule::GainSchedule;
 use super::testkit::{LittmannModel, Plant};
+use crate::drive::Amplitude;
 use crate::fx::{Q1_31, Q2_30, Q16_16};
 use crate::model::{FrictionModel, ModelError, OperatingPoint, Reach};
 use crate::protocol::{SupervisorState as S, Target};
@@ -117,7 +118,7 @@ fn sensor_fault_zeroes_the_drive_in_the_same_step_and_latches() {
         },
         &model,
     );
-    assert_eq!(out.amplitude, Q1_31::ZERO);
+    assert_eq!(out.amplitude, Amplitude::ZERO);
     assert_eq!(
         (out.state, out.reason, out.fault),
         (
@@ -129,7 +130,7 @@ fn sensor_fault_zeroes_the_drive_in_the_same_step_and_latches() {
     assert_eq!(out.reason.code(), 45);
     // Latched: healthy samples do not clear it, nor does a start.
     let out = run(&mut ctl, &model, &mut plant, 100);
-    assert_eq!((out.state, out.amplitude), (S::Fault, Q1_31::ZERO));
+    assert_eq!((out.state, out.amplitude), (S::Fault, Amplitude::ZERO));
     assert!(ctl.start().is_err());
     ctl.clear_fault().unwrap();
     assert_eq!((ctl.state(), ctl.reason()), (S::Idle, Reason::ClearCommand));
@@ -145,7 +146,7 @@ fn implausible_readings_and_model_errors_are_faults_too() {
         ..plant.measure()
     };
     let out = ctl.step(&garbage, &model);
-    assert_eq!((out.amplitude, out.state), (Q1_31::ZERO, S::Fault));
+    assert_eq!((out.amplitude, out.state), (Amplitude::ZERO, S::Fault));
     assert_eq!(out.reason.name(), "normal-out-of-range");
 
     struct Broken;
@@ -161,7 +162,7 @@ fn implausible_readings_and_model_errors_are_faults_too() {
     let out = run(&mut ctl, &Broken, &mut plant, 1);
     assert_eq!(
         (out.amplitude, out.state, out.reason),
-        (Q1_31::ZERO, S::Fault, Reason::ModelError)
+        (Amplitude::ZERO, S::Fault, Reason::ModelError)
     );
 }
 
@@ -170,7 +171,10 @@ fn external_trip_zeroes_the_drive_at_the_next_step() {
     let (mut ctl, model, mut plant) = running();
     ctl.trip(ExternalFault::Overrun);
     let out = run(&mut ctl, &model, &mut plant, 1);
-    assert_eq!((out.amplitude, out.reason), (Q1_31::ZERO, Reason::Overrun));
+    assert_eq!(
+        (out.amplitude, out.reason),
+        (Amplitude::ZERO, Reason::Overrun)
+    );
 }
 
 #[test]
@@ -195,7 +199,7 @@ fn stop_ramps_down_at_the_configured_rate() {
         if out.state == S::Idle {
             assert_eq!(
                 (out.reason, out.armed, out.amplitude),
-                (Reason::RampDone, false, Q1_31::ZERO)
+                (Reason::RampDone, false, Amplitude::ZERO)
             );
             break;
         }
@@ -219,7 +223,7 @@ fn losing_sliding_ramps_down_and_resumes_when_it_returns() {
         (last.state, last.reason, last.armed, last.sliding),
         (S::Idle, Reason::RampDone, true, false)
     );
-    assert_eq!(last.amplitude, Q1_31::ZERO);
+    assert_eq!(last.amplitude, Amplitude::ZERO);
     plant.sliding_velocity = -0.038; // the other way
     let out = run(&mut ctl, &model, &mut plant, 20);
     assert_eq!((out.state, out.reason), (S::RampUp, Reason::SlidingResumed));
@@ -244,7 +248,7 @@ fn target_at_natural_friction_holds_zero_drive() {
     let out = run(&mut ctl, &model, &mut plant, 100);
     assert_eq!(
         (out.reach, out.amplitude, out.state),
-        (Some(Reach::AboveNatural), Q1_31::ZERO, S::Running)
+        (Some(Reach::AboveNatural), Amplitude::ZERO, S::Running)
     );
     assert!(out.saturation.integral_frozen);
 }
@@ -528,7 +532,7 @@ fn the_drive_waits_until_the_natural_friction_is_learned_for_natural_learn_s() {
     let mut first_drive = None;
     for k in 1..=200 {
         let out = run(&mut ctl, &model, &mut plant, 1);
-        if first_drive.is_none() && out.amplitude > Q1_31::ZERO {
+        if first_drive.is_none() && out.amplitude > Amplitude::ZERO {
             first_drive = Some((k, out.reason));
         }
     }
@@ -540,7 +544,8 @@ fn the_drive_waits_until_the_natural_friction_is_learned_for_natural_learn_s() {
     let (mut ctl, model, mut plant) = setup();
     ctl.set_target(HALF).unwrap();
     ctl.start().unwrap();
-    let first = (1..=200).find(|_| run(&mut ctl, &model, &mut plant, 1).amplitude > Q1_31::ZERO);
+    let first =
+        (1..=200).find(|_| run(&mut ctl, &model, &mut plant, 1).amplitude > Amplitude::ZERO);
     assert!(matches!(first, Some(20..=22)), "{first:?}");
 }
 
@@ -609,11 +614,11 @@ fn run_replaced(
         let out = ctl.step(&plant.measure(), model);
         assert_eq!(
             out.amplitude,
-            Q1_31::ZERO,
+            Amplitude::ZERO,
             "idle: the controller commands nothing"
         );
         ctl.drive_replaced(applied);
-        plant.advance(applied);
+        plant.advance(Amplitude::from_command(applied));
     }
     ctl.natural_coefficient().to_f64()
 }
@@ -649,7 +654,7 @@ fn a_drive_the_controller_did_not_command_stops_mu0_learning_where_it_changes_fr
     run(&mut blind, &model, &mut blind_plant, 60);
     for _ in 0..100 {
         blind.step(&blind_plant.measure(), &model);
-        blind_plant.advance(Q1_31::from_f64(0.9).unwrap());
+        blind_plant.advance(Amplitude::from_command(Q1_31::from_f64(0.9).unwrap()));
     }
     assert!(blind.natural_coefficient().to_f64() < 0.28);
     // The drive off again: the filtered readings lag the envelope, so mu0 waits until the

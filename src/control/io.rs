@@ -2,6 +2,7 @@
 
 use super::estimate::FrictionEstimate;
 use super::reason::{Reason, SensorFault};
+use crate::drive::Amplitude;
 use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
 use crate::model::Reach;
 use crate::protocol::SupervisorState;
@@ -42,8 +43,9 @@ pub struct Saturation {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Output {
-    /// Drive amplitude command, Q1.31 fraction of full scale in [0, max amplitude].
-    pub amplitude: Q1_31,
+    /// Drive amplitude command, fraction of full scale in [0, max amplitude]: the drive's own
+    /// encoding ([`Amplitude`], unsigned Q1.31), applied as it is.
+    pub amplitude: Amplitude,
     /// Supervisor state after this step.
     pub state: SupervisorState,
     /// Reason of the last transition.

@@ -9,7 +9,7 @@ use super::pi::PiGains;
 use super::reason::{ExternalFault, Sensor, SensorFault, SensorFaultKind};
 use super::schedule::GainSchedule;
 use super::testkit::{LinearModel, LittmannModel};
-use crate::fx::{Q1_31, Q2_30, Q8_24, Q16_16};
+use crate::fx::{Q2_30, Q8_24, Q16_16};
 use crate::protocol::{SupervisorState as S, Target, TargetRange};
 
 const T: f64 = 1e-4;
@@ -68,9 +68,9 @@ proptest! {
                         sensor_fault,
                     };
                     let out = if linear { ctl.step(&inputs, &straight) } else { ctl.step(&inputs, &littmann) };
-                    prop_assert!(!out.amplitude.is_negative() && out.amplitude <= max);
+                    prop_assert!(out.amplitude.command().value <= max);
                     if sensor_fault.is_some() || matches!(out.state, S::Fault | S::Idle) {
-                        prop_assert_eq!(out.amplitude, Q1_31::ZERO);
+                        prop_assert_eq!(out.amplitude, crate::drive::Amplitude::ZERO);
                     }
                     prop_assert_eq!(out.state == S::Fault, out.fault.is_some());
                     prop_assert!(out.integral.to_bits().unsigned_abs() <= 1 << 29);

@@ -166,7 +166,7 @@ impl Plant {
     }
 
     /// Applies the drive command for one period.
-    pub fn advance(&mut self, command: Q1_31) {
+    pub fn advance(&mut self, command: crate::drive::Amplitude) {
         self.envelope += self.envelope_alpha * (command.to_f64() - self.envelope);
     }
 }

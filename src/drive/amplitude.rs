@@ -8,90 +8,118 @@
 //! so the ADC can sample in the long low-side phase (see [`crate::drive::DriveTiming`]).
 
 use super::error::DriveError;
-use crate::fx::{Q1_31, Q2_30};
+use crate::fx::{Q1_31, Q2_30, Sat};
 
 /// 1/pi in Q2.30, exactly rounded.
 const FRAC_1_PI: Q2_30 = Q2_30::from_f64_const(core::f64::consts::FRAC_1_PI);
 
-/// Drive amplitude: the fraction of full-scale fundamental voltage, Q2.30 in [0, 1].
+/// Drive amplitude: the fraction of full-scale fundamental voltage, an unsigned Q1.31
+/// (`u32` bits, 2^31 = full scale) in [0, 1], full scale included.
 ///
-/// This is the drive's encoding. The controller computes its command in Q1.31 in [0, 1)
-/// (`crate::control::Output::amplitude`: one more bit of resolution, and 1 itself is not
-/// needed, the limits keep the command below full scale); [`Amplitude::from_command`] and
-/// [`Amplitude::command`] are the only conversions between the two, so the rounding and the
-/// edges are stated once: Q1.31 to Q2.30 drops the last bit (truncation, at most 2^-31 of full
-/// scale low), Q2.30 to Q1.31 is exact below 1, and 1 becomes the largest Q1.31.
+/// The one encoding from the controller's output ([`crate::control::Output::amplitude`]) to
+/// the drive: the controller's shaper computes in Q1.31 in [0, 1) and its command becomes an
+/// amplitude exactly, every bit kept ([`Amplitude::from_command`]); full scale, which a
+/// signed Q1.31 cannot hold, is `2^31` here ([`Amplitude::FULL`], the drive's limits and the
+/// duty's edge). The drive's arithmetic that works in Q2.30 (the duty's arcsine, the resonance
+/// loop's current thresholds) reads [`Amplitude::fraction`], the amplitude truncated to Q2.30
+/// (at most 2^-31 of full scale low), the one place that rounding is made.
 ///
 /// Full scale is the fundamental of a 50 % square wave, `2 V_bus / pi`
 /// ([`crate::drive::DriveLimits`] relates it to volts on the stack).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Amplitude(Q2_30);
+pub struct Amplitude(u32);
+
+/// Full scale in [`Amplitude`]'s bits.
+const FULL_SCALE_BITS: u32 = 1 << 31;
 
 impl Amplitude {
     /// No drive (duty 0: the low-side switch stays on).
-    pub const ZERO: Self = Self(Q2_30::ZERO);
+    pub const ZERO: Self = Self(0);
     /// Full scale (duty 1/2).
-    pub const FULL: Self = Self(Q2_30::ONE);
+    pub const FULL: Self = Self(FULL_SCALE_BITS);
 
-    /// The amplitude `fraction` of full scale. Error `AmplitudeOutOfRange` outside [0, 1].
+    /// The amplitude `fraction` of full scale, exactly. Error `AmplitudeOutOfRange` outside
+    /// [0, 1].
     pub const fn new(fraction: Q2_30) -> Result<Self, DriveError> {
         let bits = fraction.to_bits();
         if bits < 0 || bits > 1 << 30 {
             return Err(DriveError::AmplitudeOutOfRange);
         }
-        Ok(Self(fraction))
+        // [0, 2^30] << 1 = [0, 2^31]: full scale at most.
+        Ok(Self((bits as u32) << 1))
     }
 
-    /// The amplitude `numerator / denominator` of full scale, rounded to nearest. Error
+    /// The amplitude of `bits` (unsigned Q1.31, 2^31 = full scale). Error
+    /// `AmplitudeOutOfRange` above full scale (never a wrap or a silent clamp).
+    pub const fn from_bits(bits: u32) -> Result<Self, DriveError> {
+        if bits > FULL_SCALE_BITS {
+            return Err(DriveError::AmplitudeOutOfRange);
+        }
+        Ok(Self(bits))
+    }
+
+    /// The amplitude `numerator / denominator` of full scale, rounded to nearest Q2.30 (the
+    /// resolution the drive's timer and the search's settings use). Error
     /// `AmplitudeOutOfRange` for a zero denominator or a ratio outside [0, 1].
     pub const fn from_ratio(numerator: u32, denominator: u32) -> Result<Self, DriveError> {
         if denominator == 0 || numerator > denominator {
             return Err(DriveError::AmplitudeOutOfRange);
         }
-        // numerator <= denominator < 2^32: numerator << 30 < 2^62.
+        // numerator <= denominator < 2^32: numerator << 30 < 2^62; the quotient <= 2^30.
         let bits = (((numerator as u64) << 30) + denominator as u64 / 2) / denominator as u64;
-        Ok(Self(Q2_30::from_bits(bits as i32)))
+        Ok(Self((bits as u32) << 1))
     }
 
-    /// The amplitude as a Q2.30 fraction in [0, 1].
+    /// The amplitude truncated to a Q2.30 fraction in [0, 1] (at most 2^-31 low), for the
+    /// drive's Q2.30 arithmetic.
     pub const fn fraction(self) -> Q2_30 {
+        // [0, 2^31] >> 1 = [0, 2^30]: fits Q2.30.
+        Q2_30::from_bits((self.0 >> 1) as i32)
+    }
+
+    /// The amplitude of a controller command (Q1.31 fraction of full scale in [-1, 1)),
+    /// exactly; a negative command is no drive (the shaper never gives one). Total: every
+    /// Q1.31 value maps into [0, 1 - 2^-31].
+    pub const fn from_command(command: Q1_31) -> Self {
+        let bits = command.to_bits();
+        Self(if bits < 0 { 0 } else { bits as u32 })
+    }
+
+    /// This amplitude as a Q1.31 command, for the controller's own arithmetic: exact below
+    /// full scale; full scale, which Q1.31 cannot hold, is Q1.31's largest value with
+    /// `saturated` set (2^-31 low; the controller's limits keep its own commands below it).
+    pub const fn command(self) -> Sat<Q1_31> {
+        if self.0 >= FULL_SCALE_BITS {
+            return Sat::clamped(Q1_31::MAX);
+        }
+        Sat::exact(Q1_31::from_bits(self.0 as i32))
+    }
+
+    /// The raw bits, unsigned Q1.31: 0 to `1 << 31`.
+    pub const fn bits(self) -> u32 {
         self.0
     }
 
-    /// The drive amplitude of a controller command (Q1.31 fraction of full scale in [-1, 1)):
-    /// the command with its last bit dropped; a negative command is no drive. Total: every
-    /// Q1.31 value maps into [0, 1 - 2^-30].
-    pub const fn from_command(command: Q1_31) -> Self {
-        let bits = command.to_bits();
-        // [0, 2^31 - 1] >> 1 = [0, 2^30 - 1]: inside [0, 1].
-        Self(Q2_30::from_bits(if bits < 0 { 0 } else { bits >> 1 }))
+    /// The amplitude times `unit`, rounded to the nearest integer (ties up): full scale is
+    /// `unit`. Exact; `bits x unit < 2^63` never overflows.
+    pub const fn round_scaled(self, unit: u32) -> u64 {
+        (self.0 as u64 * unit as u64 + (1 << 30)) >> 31
     }
 
-    /// This amplitude as a controller command, Q1.31 in [0, 1): exact below full scale; full
-    /// scale (1, which Q1.31 cannot hold) is its largest value, 1 - 2^-31.
-    pub const fn command(self) -> Q1_31 {
-        // bits in [0, 2^30]: << 1 is at most 2^31, one past i32::MAX at full scale only.
-        let doubled = (self.0.to_bits() as i64) << 1;
-        Q1_31::from_bits(if doubled > i32::MAX as i64 {
-            i32::MAX
-        } else {
-            doubled as i32
-        })
+    /// The amplitude as a fraction of full scale, exactly.
+    pub const fn to_f64(self) -> f64 {
+        self.0 as f64 / FULL_SCALE_BITS as f64
     }
 
-    /// The raw Q2.30 bits, 0 to `1 << 30`.
-    pub const fn bits(self) -> u32 {
-        self.0.to_bits() as u32
+    /// The amplitude as a fraction of full scale, rounded once to nearest `f32`.
+    pub const fn to_f32(self) -> f32 {
+        self.to_f64() as f32
     }
 
     /// The smaller of two amplitudes.
     pub const fn min(self, other: Self) -> Self {
-        if self.0.to_bits() <= other.0.to_bits() {
-            self
-        } else {
-            other
-        }
+        if self.0 <= other.0 { self } else { other }
     }
 
     /// The duty cycle `asin(a) / pi` (Q2.30, 0 to 1/2) whose fundamental is this amplitude.
@@ -100,7 +128,7 @@ impl Amplitude {
     pub const fn duty(self) -> Q2_30 {
         // The amplitude is in [0, 1], the domain of asin, and asin(a)/pi <= 1/2 fits Q2.30,
         // so neither error arm can be taken; both fall back to no drive.
-        match self.0.asin() {
+        match self.fraction().asin() {
             Ok(angle) => match angle.checked_mul(FRAC_1_PI) {
                 Ok(duty) => duty,
                 Err(_) => Q2_30::ZERO,
@@ -115,38 +143,77 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_controller_command_converts_at_its_extremes() {
-        // Zero, the smallest positive step, the largest command, and every negative one.
+    fn a_controller_command_becomes_an_amplitude_exactly() {
+        // Zero, the smallest positive step, the largest command: every bit kept.
         assert_eq!(Amplitude::from_command(Q1_31::ZERO), Amplitude::ZERO);
-        assert_eq!(Amplitude::from_command(Q1_31::from_bits(1)).bits(), 0); // below one Q2.30 lsb
-        assert_eq!(Amplitude::from_command(Q1_31::from_bits(2)).bits(), 1);
-        assert_eq!(Amplitude::from_command(Q1_31::MAX).bits(), (1 << 30) - 1);
+        assert_eq!(Amplitude::from_command(Q1_31::from_bits(1)).bits(), 1);
+        assert_eq!(
+            Amplitude::from_command(Q1_31::MAX).bits(),
+            FULL_SCALE_BITS - 1
+        );
+        // A negative command (the shaper never gives one) is no drive, never a wrap to a
+        // large amplitude.
         assert_eq!(
             Amplitude::from_command(Q1_31::from_bits(-1)),
             Amplitude::ZERO
         );
         assert_eq!(Amplitude::from_command(Q1_31::MIN), Amplitude::ZERO);
-        // Against the f64 value: truncation, never more than one Q2.30 lsb low, never high.
+        // Against the f64 value: exact, and the round trip gives the command back.
         for bits in [1, 3, 12_345, 1 << 20, (1 << 30) + 7, i32::MAX - 1, i32::MAX] {
-            let command = Q1_31::from_bits(bits).to_f64();
-            let amplitude = Amplitude::from_command(Q1_31::from_bits(bits))
-                .fraction()
-                .to_f64();
-            assert!(amplitude <= command && command - amplitude < 1.0 / f64::from(1 << 30));
+            let command = Q1_31::from_bits(bits);
+            let amplitude = Amplitude::from_command(command);
+            assert_eq!(amplitude.to_f64(), command.to_f64());
+            assert_eq!(amplitude.to_f32(), command.to_f32());
+            assert_eq!(amplitude.command(), Sat::exact(command));
         }
     }
 
     #[test]
-    fn an_amplitude_converts_to_a_command_exactly_below_full_scale() {
-        assert_eq!(Amplitude::ZERO.command(), Q1_31::ZERO);
-        assert_eq!(Amplitude::FULL.command(), Q1_31::MAX);
-        let below_full = Amplitude::new(Q2_30::from_bits((1 << 30) - 1)).unwrap();
-        assert_eq!(below_full.command().to_bits(), i32::MAX - 1);
+    fn the_drive_fraction_truncates_to_q2_30_and_keeps_full_scale() {
+        assert_eq!(Amplitude::ZERO.fraction(), Q2_30::ZERO);
+        assert_eq!(Amplitude::FULL.fraction(), Q2_30::ONE);
+        // One Q1.31 lsb is below one Q2.30 lsb: dropped, never rounded up.
+        assert_eq!(
+            Amplitude::from_command(Q1_31::from_bits(1)).fraction(),
+            Q2_30::ZERO
+        );
+        assert_eq!(
+            Amplitude::from_command(Q1_31::MAX).fraction().to_bits(),
+            (1 << 30) - 1
+        );
+        for bits in [1, 3, 12_345, 1 << 20, (1 << 30) + 7, i32::MAX - 1, i32::MAX] {
+            let amplitude = Amplitude::from_command(Q1_31::from_bits(bits));
+            let fraction = amplitude.fraction().to_f64();
+            assert!(fraction <= amplitude.to_f64());
+            assert!(amplitude.to_f64() - fraction < 1.0 / f64::from(1 << 30));
+        }
+    }
+
+    #[test]
+    fn full_scale_is_an_amplitude_and_a_flagged_command() {
+        assert_eq!(Amplitude::FULL.to_f64(), 1.0);
+        assert_eq!(Amplitude::FULL.command(), Sat::clamped(Q1_31::MAX));
+        assert_eq!(Amplitude::ZERO.command(), Sat::exact(Q1_31::ZERO));
+        let below_full = Amplitude::from_bits(FULL_SCALE_BITS - 1).unwrap();
+        assert_eq!(below_full.command(), Sat::exact(Q1_31::MAX));
         for (numerator, denominator) in [(1, 1000), (1, 4), (707, 1000), (999_999, 1_000_000)] {
             let a = Amplitude::from_ratio(numerator, denominator).unwrap();
-            assert_eq!(a.command().to_f64(), a.fraction().to_f64());
-            // The round trip returns the amplitude: no bit is lost below full scale.
-            assert_eq!(Amplitude::from_command(a.command()), a);
+            assert_eq!(a.command().value.to_f64(), a.to_f64());
+            assert_eq!(Amplitude::from_command(a.command().value), a);
+        }
+    }
+
+    #[test]
+    fn round_scaled_is_the_command_s_below_full_scale_and_unit_at_it() {
+        assert_eq!(Amplitude::FULL.round_scaled(1_000_000), 1_000_000);
+        assert_eq!(Amplitude::FULL.round_scaled(u32::MAX), u64::from(u32::MAX));
+        assert_eq!(Amplitude::ZERO.round_scaled(u32::MAX), 0);
+        for bits in [1, 1 << 20, (1 << 30) + 7, i32::MAX] {
+            let command = Q1_31::from_bits(bits);
+            assert_eq!(
+                Amplitude::from_command(command).round_scaled(1_000_000),
+                command.round_scaled(1_000_000) as u64
+            );
         }
     }
 
@@ -162,7 +229,17 @@ mod tests {
             Amplitude::new(Q2_30::from_bits(-1)),
             Err(DriveError::AmplitudeOutOfRange)
         );
-        assert_eq!(Amplitude::from_ratio(1, 4).unwrap().bits(), 1 << 28);
+        // Over full scale is an error, not a wrap: the largest u32 is not a small amplitude.
+        assert_eq!(Amplitude::from_bits(FULL_SCALE_BITS), Ok(Amplitude::FULL));
+        assert_eq!(
+            Amplitude::from_bits(FULL_SCALE_BITS + 1),
+            Err(DriveError::AmplitudeOutOfRange)
+        );
+        assert_eq!(
+            Amplitude::from_bits(u32::MAX),
+            Err(DriveError::AmplitudeOutOfRange)
+        );
+        assert_eq!(Amplitude::from_ratio(1, 4).unwrap().bits(), 1 << 29);
         assert_eq!(
             Amplitude::from_ratio(u32::MAX, u32::MAX),
             Ok(Amplitude::FULL)

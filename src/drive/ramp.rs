@@ -10,7 +10,7 @@ use super::amplitude::Amplitude;
 use super::error::DriveError;
 
 /// Full scale in Q2.30 bits.
-const FULL_BITS: u32 = 1 << 30;
+const FULL_BITS: u32 = Amplitude::FULL.bits();
 
 /// An amplitude that follows its target at a limited rate. State plus two constants; `Copy`
 /// so a control loop can swap configurations atomically.
@@ -62,7 +62,7 @@ impl AmplitudeRamp {
             now = now.saturating_sub(self.fall_per_step).max(goal);
         }
         // `now` lies between two valid amplitudes, so it is one too.
-        self.now = match Amplitude::from_ratio(now, FULL_BITS) {
+        self.now = match Amplitude::from_bits(now) {
             Ok(amplitude) => amplitude,
             Err(_) => Amplitude::ZERO,
         };
@@ -124,7 +124,7 @@ mod tests {
         while ramp.now() != Amplitude::ZERO {
             let before = ramp.now();
             let now = ramp.step(Amplitude::ZERO, Amplitude::FULL);
-            assert!(before.bits() - now.bits() <= (1 << 30) / 50 + 1);
+            assert!(before.bits() - now.bits() <= (1 << 31) / 50 + 1);
             steps += 1;
         }
         assert_eq!(steps, 50);

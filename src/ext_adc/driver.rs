@@ -10,6 +10,7 @@ use embedded_hal::spi::SpiDevice;
 
 use super::frame::{CrcMismatch, DeviceFrame, FRAME_BYTES, command, decode, encode};
 use super::registers::{CHANNEL_COUNT, Config, MODE_VALUE, Status, address};
+use crate::sense::AdcCode;
 
 /// Wait after the RESET command before the next frame, in microseconds: generous against the
 /// time the device takes to reload its register defaults (datasheet, "RESET" command), and
@@ -63,9 +64,9 @@ pub enum Error<E> {
 pub struct Sample {
     /// STATUS at the time of reading (DRDY bits say which channels are new).
     pub status: Status,
-    /// Channel 0 and 1, signed 24-bit counts (full scale +-1.2 V / gain); feed them to
+    /// Channel 0 and 1, signed 24-bit codes (full scale +-1.2 V / gain) of the format
     /// `sense::AdcFormat::bipolar(24)`.
-    pub codes: [i32; 2],
+    pub codes: [AdcCode; 2],
 }
 
 /// An ADS131M02 on an SPI device.

@@ -10,6 +10,7 @@
 //! "Commands": "the expected response that appears in the following frame").
 
 use super::crc::crc16_ccitt;
+use crate::sense::AdcCode;
 
 /// Bytes per 24-bit word.
 pub const WORD_BYTES: usize = 3;
@@ -62,9 +63,9 @@ pub const fn encode(command: u16, data: u16) -> [u8; FRAME_BYTES] {
 pub struct DeviceFrame {
     /// The response word (to the previous frame's command), its 16 significant bits.
     pub response: u16,
-    /// Conversion results of channel 0 and 1, signed 24-bit counts (-8 388 608 to 8 388 607;
+    /// Conversion results of channel 0 and 1, signed 24-bit codes (-8 388 608 to 8 388 607;
     /// full scale is +-1.2 V / gain).
-    pub codes: [i32; 2],
+    pub codes: [AdcCode; 2],
 }
 
 /// The CRC word of a frame did not match its contents.
@@ -87,7 +88,10 @@ pub const fn decode(frame: &[u8; FRAME_BYTES]) -> Result<DeviceFrame, CrcMismatc
     }
     Ok(DeviceFrame {
         response: u16::from_be_bytes([frame[0], frame[1]]),
-        codes: [word24(frame, 1), word24(frame, 2)],
+        codes: [
+            AdcCode::new(word24(frame, 1)),
+            AdcCode::new(word24(frame, 2)),
+        ],
     })
 }
 
@@ -134,7 +138,10 @@ mod tests {
     fn codes_are_sign_extended_from_24_bits() {
         for code in [0, 1, -1, 0x7F_FFFF, -0x80_0000, 123_456, -654_321] {
             let decoded = decode(&device(0x0503, [code, -code.max(-0x7F_FFFF)])).unwrap();
-            assert_eq!(decoded.codes, [code, -code.max(-0x7F_FFFF)]);
+            assert_eq!(
+                decoded.codes,
+                [code, -code.max(-0x7F_FFFF)].map(AdcCode::new)
+            );
             assert_eq!(decoded.response, 0x0503);
         }
     }

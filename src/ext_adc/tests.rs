@@ -14,6 +14,7 @@ use super::crc::crc16_ccitt;
 use super::frame::{CrcMismatch, FRAME_BYTES, command, encode};
 use super::registers::{Config, Gain, MODE_VALUE, Osr, Status, address};
 use super::{Ads131m02, Error};
+use crate::sense::AdcCode;
 
 /// An SPI error from the mock bus.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -178,10 +179,10 @@ fn samples_are_signed_24_bit_with_their_status() {
     let mut adc = Ads131m02::new(spi);
     adc.init(&CONFIG, &mut Delay::default()).unwrap();
     let first = adc.read_sample().unwrap();
-    assert_eq!(first.codes, [-1_234_567, 7_654_321]);
+    assert_eq!(first.codes, [-1_234_567, 7_654_321].map(AdcCode::new));
     assert!(first.status.data_ready(0) && first.status.data_ready(1));
     let second = adc.read_sample().unwrap();
-    assert_eq!(second.codes, [-0x80_0000, 0x7F_FFFF]);
+    assert_eq!(second.codes, [-0x80_0000, 0x7F_FFFF].map(AdcCode::new));
     assert_eq!(second.status, Status(0x0101));
     assert!(!second.status.data_ready(1));
     assert!(adc.release().done());

@@ -40,6 +40,7 @@
 
 use super::error::ResonanceError;
 use super::phasor::Phasor;
+use crate::control::SampleBlock;
 use crate::drive::Frequency;
 use crate::fx::{self, Q1_31, Q2_30, mul_hi_round};
 
@@ -69,33 +70,51 @@ pub struct Demodulated {
     pub samples: u32,
 }
 
-/// The lock-in demodulator: settings, reference phase and running sums.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct LockIn {
-    config: LockInConfig,
+/// The lock-in's configuration at one drive frequency: what [`LockIn::retune`] derives from
+/// the settings and the frequency. `Copy`, replaced whole at a retune (between two samples),
+/// never changed by a sample; the block of [`SampleBlock`] whose state is [`LockInSums`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Demodulator {
     /// Drive phase advance per sample, turns x 2^32 (aliased).
     step: u32,
     /// Phase of the drive over the sense delay, turns x 2^32.
     delay: u32,
+    /// Samples per window, 1 to [`MAX_WINDOW_SAMPLES`].
     window: u32,
     /// `round(2^62 / window)`.
     inv_window_q62: i64,
     /// `sin(N step) / sin(step)`, Q2.30 in [-1, 1]: the size of the window's sum of
     /// `exp(2 j theta)` (see `finish`).
     double_sum_q30: i64,
+}
+
+/// The lock-in's state: the drive phase and the running sums of the window under way.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct LockInSums {
     /// Drive phase at the next sample, turns x 2^32.
     drive_phase: u32,
     /// Reference phase (drive minus delay) at the window's first sample, turns x 2^32.
     window_start: u32,
+    /// Samples taken in this window, below the window's length.
     count: u32,
+    /// Sums of the products, Q2.30, and of `x`, `cos`, `sin`, Q1.31 (bounds: module doc).
     sum_x_cos: i64,
     sum_x_sin: i64,
     sum_x: i64,
     sum_cos: i64,
     sum_sin: i64,
+}
+
+/// The lock-in demodulator: its settings, the [`Demodulator`] at the present frequency and
+/// the [`LockInSums`] it runs on.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LockIn {
+    config: LockInConfig,
     /// PWM-synchronous sampling ([`Self::synchronous`]): the reference's advance per sample
     /// is this, whatever the drive frequency.
     fixed_step: Option<u32>,
+    demodulator: Demodulator,
+    sums: LockInSums,
 }
 
 impl LockIn {
@@ -131,88 +150,53 @@ impl LockIn {
     ) -> Result<Self, ResonanceError> {
         let mut lock_in = Self {
             config,
-            step: 0,
-            delay: 0,
-            window: 1,
-            inv_window_q62: 0, // set by `retune`, like the other zeros here
-            double_sum_q30: 0,
-            drive_phase: 0,
-            window_start: 0,
-            count: 0,
-            sum_x_cos: 0,
-            sum_x_sin: 0,
-            sum_x: 0,
-            sum_cos: 0,
-            sum_sin: 0,
             fixed_step,
+            // Set by `retune`: `inv_window_q62 == 0` marks a demodulator not yet set up.
+            demodulator: Demodulator {
+                step: 0,
+                delay: 0,
+                window: 1,
+                inv_window_q62: 0,
+                double_sum_q30: 0,
+            },
+            sums: LockInSums::default(),
         };
         lock_in.retune(drive)?;
         Ok(lock_in)
     }
 
-    /// Follows the drive to `drive` (the achieved frequency). Any partial window is discarded
-    /// (it mixed two frequencies); the drive phase carries on, as the timer's does. On error
-    /// nothing changes. A few 64/128-bit divisions: for a control step, not for every sample.
+    /// Follows the drive to `drive` (the achieved frequency): a new [`Demodulator`]. Any
+    /// partial window is discarded (it mixed two frequencies); the drive phase carries on, as
+    /// the timer's does. On error nothing changes. A few 64/128-bit divisions: for a control
+    /// step, not for every sample.
     ///
     /// Errors: `SamplingTooSlow` for fewer than 3 samples per turn of the aliased drive phase,
     /// `WindowLength` for zero periods or a window above [`MAX_WINDOW_SAMPLES`].
     pub fn retune(&mut self, drive: Frequency) -> Result<(), ResonanceError> {
         // Synchronous sampling without a sense delay: nothing depends on the frequency once
         // the window is set up (`inv_window_q62 != 0`), so a retune only starts a new window.
-        if self.fixed_step.is_some() && self.config.sense_delay_ns == 0 && self.inv_window_q62 != 0
+        if self.fixed_step.is_some()
+            && self.config.sense_delay_ns == 0
+            && self.demodulator.inv_window_q62 != 0
         {
-            self.clear();
+            self.demodulator.clear(&mut self.sums);
             return Ok(());
         }
-        let rate = u128::from(self.config.sample_rate_hz) * 1000;
-        if rate == 0 {
-            return Err(ResonanceError::SamplingTooSlow);
-        }
-        let millihertz = u128::from(drive.millihertz());
-        // Turns per sample x 2^32, rounded, reduced to the aliased rotation (or the fixed
-        // advance of PWM-synchronous sampling).
-        let step = match self.fixed_step {
-            Some(step) => step,
-            None => (((millihertz << 32) + rate / 2) / rate) as u32,
-        };
-        let rotation = u64::from((step as i32).unsigned_abs());
-        if rotation == 0 || rotation * 3 > 1 << 32 {
-            return Err(ResonanceError::SamplingTooSlow);
-        }
-        let turns = u64::from(self.config.periods_per_window);
-        let window = ((turns << 32) + rotation / 2) / rotation;
-        if turns == 0 || window > u64::from(MAX_WINDOW_SAMPLES) {
-            return Err(ResonanceError::WindowLength);
-        }
-        // f t_d in turns x 2^32: mHz * ns * 2^32 / 1e12, rounded; f < 2^32 mHz and
-        // t_d < 2^32 ns keep the product below 2^96.
-        let delay_turns = (millihertz * u128::from(self.config.sense_delay_ns)) << 32;
-        let delay = ((delay_turns + 500_000_000_000) / 1_000_000_000_000) as u32;
-        // sin(N step) = sin(residual), |residual| <= step / 2, so the ratio is at most
-        // 1 / (2 cos(step / 2)) <= 1 for step <= 2 pi / 3; sin(step) != 0 since rotation != 0
-        // and < 1/3 turn.
-        let sin_n_step = i64::from(fx::sin(step.wrapping_mul(window as u32)).to_bits());
-        let sin_step = i64::from(fx::sin(step).to_bits());
-        let ratio = (sin_n_step << 30) / sin_step;
-        self.step = step;
-        self.delay = delay;
-        self.window = window as u32;
-        self.inv_window_q62 = (((1u64 << 62) + window / 2) / window) as i64;
-        self.double_sum_q30 = ratio.clamp(-(1 << 30), 1 << 30);
-        self.clear();
+        self.demodulator = Demodulator::at(&self.config, self.fixed_step, drive)?;
+        self.demodulator.clear(&mut self.sums);
         Ok(())
     }
 
     /// Sets the drive phase at the next sample (turns x 2^32, 0 = voltage maximum), for boards
     /// and simulations that know it, and discards any partial window.
     pub fn set_drive_phase(&mut self, turns: u32) {
-        self.drive_phase = turns;
-        self.clear();
+        self.sums.drive_phase = turns;
+        self.demodulator.clear(&mut self.sums);
     }
 
     /// Samples per window at the present frequency.
     pub const fn window_samples(&self) -> u32 {
-        self.window
+        self.demodulator.window
     }
 
     /// The settings.
@@ -221,24 +205,60 @@ impl LockIn {
     }
 
     /// Takes one current sample (Q1.31 fraction of full scale); at the end of each window
-    /// returns the fundamental and starts the next window. Fixed point, no division.
+    /// returns the fundamental and starts the next window: the [`Demodulator`]'s
+    /// [`SampleBlock::process`] on this lock-in's sums. Fixed point, no division.
     #[inline]
     pub fn push(&mut self, sample: Q1_31) -> Option<Demodulated> {
-        let (sin, cos) = fx::sin_cos(self.drive_phase.wrapping_sub(self.delay));
-        let (x, sin, cos) = (sample.to_bits(), sin.to_bits(), cos.to_bits());
-        self.sum_x_cos += i64::from(mul_hi_round(x, cos));
-        self.sum_x_sin += i64::from(mul_hi_round(x, sin));
-        self.sum_x += i64::from(x);
-        self.sum_cos += i64::from(cos);
-        self.sum_sin += i64::from(sin);
-        self.drive_phase = self.drive_phase.wrapping_add(self.step);
-        self.count += 1;
-        if self.count < self.window {
-            return None;
+        self.demodulator.process(&mut self.sums, sample)
+    }
+}
+
+impl Demodulator {
+    /// The demodulator of `config` for a drive at `drive` (the achieved frequency), the
+    /// reference advancing by `fixed_step` per sample when given. Errors: see
+    /// [`LockIn::retune`].
+    fn at(
+        config: &LockInConfig,
+        fixed_step: Option<u32>,
+        drive: Frequency,
+    ) -> Result<Self, ResonanceError> {
+        let rate = u128::from(config.sample_rate_hz) * 1000;
+        if rate == 0 {
+            return Err(ResonanceError::SamplingTooSlow);
         }
-        let result = self.finish();
-        self.clear();
-        Some(result)
+        let millihertz = u128::from(drive.millihertz());
+        // Turns per sample x 2^32, rounded, reduced to the aliased rotation (or the fixed
+        // advance of PWM-synchronous sampling).
+        let step = match fixed_step {
+            Some(step) => step,
+            None => (((millihertz << 32) + rate / 2) / rate) as u32,
+        };
+        let rotation = u64::from((step as i32).unsigned_abs());
+        if rotation == 0 || rotation * 3 > 1 << 32 {
+            return Err(ResonanceError::SamplingTooSlow);
+        }
+        let turns = u64::from(config.periods_per_window);
+        let window = ((turns << 32) + rotation / 2) / rotation;
+        if turns == 0 || window > u64::from(MAX_WINDOW_SAMPLES) {
+            return Err(ResonanceError::WindowLength);
+        }
+        // f t_d in turns x 2^32: mHz * ns * 2^32 / 1e12, rounded; f < 2^32 mHz and
+        // t_d < 2^32 ns keep the product below 2^96.
+        let delay_turns = (millihertz * u128::from(config.sense_delay_ns)) << 32;
+        let delay = ((delay_turns + 500_000_000_000) / 1_000_000_000_000) as u32;
+        // sin(N step) = sin(residual), |residual| <= step / 2, so the ratio is at most
+        // 1 / (2 cos(step / 2)) <= 1 for step <= 2 pi / 3; sin(step) != 0 since rotation != 0
+        // and < 1/3 turn.
+        let sin_n_step = i64::from(fx::sin(step.wrapping_mul(window as u32)).to_bits());
+        let sin_step = i64::from(fx::sin(step).to_bits());
+        let ratio = (sin_n_step << 30) / sin_step;
+        Ok(Self {
+            step,
+            delay,
+            window: window as u32,
+            inv_window_q62: (((1u64 << 62) + window / 2) / window) as i64,
+            double_sum_q30: ratio.clamp(-(1 << 30), 1 << 30),
+        })
     }
 
     /// Scales the window's sums into a phasor (once per window): the least-squares fit of
@@ -251,18 +271,18 @@ impl LockIn {
     /// `a = (2/N) (X_c - (C2 X_c + S2 X_s) / N)`, `b = -(2/N) (X_s + (C2 X_s - S2 X_c) / N)`.
     /// What is left is of order `1/N^2` (a window missing whole turns by half a sample errs by
     /// up to `1/N` without this).
-    fn finish(&self) -> Demodulated {
+    fn finish(&self, sums: &LockInSums) -> Demodulated {
         let inv = i128::from(self.inv_window_q62);
         let per_window = |v: i128| (v * inv + (1 << 61)) >> 62; // v / N
         // Window mean of x, Q1.31 bits (|mean| <= 2^31).
-        let mean = per_window(i128::from(self.sum_x));
+        let mean = per_window(i128::from(sums.sum_x));
         // Offset-free sums: the mean times the sum of cos is Q1.31 x Q1.31, brought to the
         // Q2.30 scale of the products by 2^-32.
         let x_cos =
-            i128::from(self.sum_x_cos) - ((mean * i128::from(self.sum_cos) + (1 << 31)) >> 32);
+            i128::from(sums.sum_x_cos) - ((mean * i128::from(sums.sum_cos) + (1 << 31)) >> 32);
         let x_sin =
-            i128::from(self.sum_x_sin) - ((mean * i128::from(self.sum_sin) + (1 << 31)) >> 32);
-        let angle = self
+            i128::from(sums.sum_x_sin) - ((mean * i128::from(sums.sum_sin) + (1 << 31)) >> 32);
+        let angle = sums
             .window_start
             .wrapping_mul(2)
             .wrapping_add(self.step.wrapping_mul(self.window.wrapping_sub(1)));
@@ -278,18 +298,46 @@ impl LockIn {
         let quadrature = saturate((b_sum * inv + (1 << 60)) >> 61);
         Demodulated {
             phasor: Phasor::new(in_phase, quadrature),
-            samples: self.count,
+            samples: sums.count,
         }
     }
 
-    fn clear(&mut self) {
-        self.window_start = self.drive_phase.wrapping_sub(self.delay);
-        self.count = 0;
-        self.sum_x_cos = 0;
-        self.sum_x_sin = 0;
-        self.sum_x = 0;
-        self.sum_cos = 0;
-        self.sum_sin = 0;
+    /// Starts a new window at the next sample.
+    fn clear(&self, sums: &mut LockInSums) {
+        sums.window_start = sums.drive_phase.wrapping_sub(self.delay);
+        sums.count = 0;
+        sums.sum_x_cos = 0;
+        sums.sum_x_sin = 0;
+        sums.sum_x = 0;
+        sums.sum_cos = 0;
+        sums.sum_sin = 0;
+    }
+}
+
+/// The lock-in: one current sample (Q1.31 fraction of full scale) into the window's sums; at
+/// the end of each window the fundamental, and the next window starts. Fixed point, no
+/// division; never overflows (module doc).
+impl SampleBlock<Q1_31> for Demodulator {
+    type State = LockInSums;
+    type Output = Option<Demodulated>;
+
+    #[inline]
+    fn process(&self, sums: &mut LockInSums, sample: Q1_31) -> Option<Demodulated> {
+        let (sin, cos) = fx::sin_cos(sums.drive_phase.wrapping_sub(self.delay));
+        let (x, sin, cos) = (sample.to_bits(), sin.to_bits(), cos.to_bits());
+        sums.sum_x_cos += i64::from(mul_hi_round(x, cos));
+        sums.sum_x_sin += i64::from(mul_hi_round(x, sin));
+        sums.sum_x += i64::from(x);
+        sums.sum_cos += i64::from(cos);
+        sums.sum_sin += i64::from(sin);
+        sums.drive_phase = sums.drive_phase.wrapping_add(self.step);
+        sums.count += 1;
+        if sums.count < self.window {
+            return None;
+        }
+        let result = self.finish(sums);
+        self.clear(sums);
+        Some(result)
     }
 }
 

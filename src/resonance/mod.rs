@@ -78,7 +78,7 @@ pub use follow::{
     LOST_WINDOWS, LockState, ResonanceLoop, ResonanceReport, ResonanceSettings,
     SYNCHRONOUS_FIRST_PHASE, SYNCHRONOUS_PHASE_STEP, current_sample,
 };
-pub use lockin::{Demodulated, LockIn, LockInConfig, MAX_WINDOW_SAMPLES};
+pub use lockin::{Demodulated, Demodulator, LockIn, LockInConfig, LockInSums, MAX_WINDOW_SAMPLES};
 pub use motional::{ClampedCapacitance, MAX_DETUNING, detuning};
 pub use phasor::{Angle, Phasor, Polar};
 pub use ringdown::{
@@ -91,5 +91,8 @@ pub use search::{
 };
 pub use stack::{StackModel, StackSettings};
 pub use sweep::{Sweep, SweepPlan, SweepPoint, SweepProgress, SweepResult};
-pub use tracker::{LOOP_DAMPING, TrackStatus, Tracker, TrackerConfig, TrackerSettings};
+pub use tracker::{
+    LOOP_DAMPING, TrackStatus, TrackWindow, Tracker, TrackerConfig, TrackerSettings, TrackerState,
+    TrackingLoop,
+};
 pub use tuning::Tuning;

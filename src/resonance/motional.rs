@@ -91,7 +91,7 @@ impl ClampedCapacitance {
             full
         };
         // amplitude <= 2^30 (Q2.30 in [0, 1]).
-        let bits = (full * amplitude.bits() as u64 + (1 << 29)) >> 30;
+        let bits = (full * amplitude.fraction().to_bits() as u64 + (1 << 29)) >> 30;
         Q2_30::from_bits(bits as i32)
     }
 

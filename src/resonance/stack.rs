@@ -101,7 +101,9 @@ impl StackModel {
 
     /// The no-current threshold at drive `amplitude`, Q2.30 full scale (one multiplication).
     pub const fn min_current(&self, amplitude: Amplitude) -> Q2_30 {
-        let bits = (self.min_current.to_bits() as i64 * amplitude.bits() as i64 + (1 << 29)) >> 30;
+        let bits = (self.min_current.to_bits() as i64 * amplitude.fraction().to_bits() as i64
+            + (1 << 29))
+            >> 30;
         Q2_30::from_bits(bits as i32)
     }
 }

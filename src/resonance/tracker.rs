@@ -28,6 +28,7 @@ use super::motional::{MAX_DETUNING, detuning};
 use super::phasor::Phasor;
 use super::stack::StackModel;
 use super::tuning::Tuning;
+use crate::control::SampleBlock;
 use crate::drive::{Amplitude, Frequency, TimerClock};
 use crate::fx::Q8_24;
 
@@ -225,18 +226,50 @@ pub struct TrackStatus {
     pub rate_limited: bool,
 }
 
-/// The tracking loop's state.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Tracker {
+/// The tracking loop as a block: its gains and limits and the timer clock its command is
+/// rounded to. `Copy`, replaced whole by [`Tracker::reconfigure`] between two windows, never
+/// changed by a window; the block of [`SampleBlock`] whose state is [`TrackerState`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TrackingLoop {
     config: TrackerConfig,
     clock: TimerClock,
-    /// The loop's frequency (finer than the timer's grid), mHz.
+}
+
+/// One lock-in window for the tracker: the current measured at the state's
+/// [`TrackerState::tuning`] with drive `amplitude`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TrackWindow {
+    /// The lock-in's window.
+    pub window: Demodulated,
+    /// The drive amplitude during the window.
+    pub amplitude: Amplitude,
+}
+
+/// The tracking loop's state: its fine frequency, the drive setting in force, the previous
+/// error (velocity form) and the lock, limit and no-current counts.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TrackerState {
+    /// The loop's frequency (finer than the timer's grid), mHz, within the loop's limits.
     command_mhz: i64,
     tuning: Tuning,
     previous_error_mhz: i64,
     in_lock: u16,
     at_limit: u16,
     without_current: u16,
+}
+
+impl TrackerState {
+    /// The drive setting in force.
+    pub const fn tuning(&self) -> Tuning {
+        self.tuning
+    }
+}
+
+/// The tracking loop: a [`TrackingLoop`] and the [`TrackerState`] it runs on.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Tracker {
+    block: TrackingLoop,
+    state: TrackerState,
 }
 
 impl Tracker {
@@ -250,70 +283,97 @@ impl Tracker {
         let command = clamp(i64::from(start.millihertz()), &config);
         let tuning = Tuning::nearest(Frequency::from_millihertz(command as u32), clock)?;
         Ok(Self {
-            config,
-            clock,
-            command_mhz: command,
-            tuning,
-            previous_error_mhz: 0,
-            in_lock: 0,
-            at_limit: 0,
-            without_current: 0,
+            block: TrackingLoop { config, clock },
+            state: TrackerState {
+                command_mhz: command,
+                tuning,
+                previous_error_mhz: 0,
+                in_lock: 0,
+                at_limit: 0,
+                without_current: 0,
+            },
         })
     }
 
     /// Switches to `config` (for example from pull-in to operation) keeping the frequency
     /// (clamped to the new limits) and the lock count. Error as [`Self::new`].
     pub fn reconfigure(&mut self, config: TrackerConfig) -> Result<(), ResonanceError> {
-        let command = clamp(self.command_mhz, &config);
-        self.tuning = Tuning::nearest(Frequency::from_millihertz(command as u32), self.clock)?;
-        self.command_mhz = command;
-        self.config = config;
+        let state = &mut self.state;
+        let command = clamp(state.command_mhz, &config);
+        state.tuning =
+            Tuning::nearest(Frequency::from_millihertz(command as u32), self.block.clock)?;
+        state.command_mhz = command;
+        self.block.config = config;
         Ok(())
     }
 
     /// The drive setting in force.
     pub const fn tuning(&self) -> Tuning {
-        self.tuning
+        self.state.tuning
     }
 
-    /// One control step from the window measured at [`Self::tuning`] with drive `amplitude`.
-    /// With zero amplitude nothing is measured and the frequency holds. Fixed point: one
-    /// division ([`detuning`]), a CORDIC, 128-bit products; [`Tuning::nearest`] divides once.
-    ///
-    /// Errors: `NoCurrent` after `no_current_windows` windows whose current stayed below the
-    /// stack's threshold; `AtFrequencyLimit` after `limit_windows` windows pinned at a limit.
+    /// One control step from the window measured at [`Self::tuning`] with drive `amplitude`:
+    /// the [`TrackingLoop`]'s [`SampleBlock::process`] on this tracker's state.
     pub fn update(
         &mut self,
         window: &Demodulated,
         amplitude: Amplitude,
     ) -> Result<TrackStatus, ResonanceFault> {
+        let input = TrackWindow {
+            window: *window,
+            amplitude,
+        };
+        self.block.process(&mut self.state, input)
+    }
+}
+
+/// One control step from a window. With zero amplitude nothing is measured and the frequency
+/// holds. Fixed point: one division ([`detuning`]), a CORDIC, 128-bit products;
+/// [`Tuning::nearest`] divides once.
+///
+/// Errors: `NoCurrent` after `no_current_windows` windows whose current stayed below the
+/// stack's threshold; `AtFrequencyLimit` after `limit_windows` windows pinned at a limit.
+impl SampleBlock<TrackWindow> for TrackingLoop {
+    type State = TrackerState;
+    type Output = Result<TrackStatus, ResonanceFault>;
+
+    fn process(
+        &self,
+        state: &mut TrackerState,
+        input: TrackWindow,
+    ) -> Result<TrackStatus, ResonanceFault> {
         let stack = self.config.stack;
         let mut status = TrackStatus {
-            tuning: self.tuning,
+            tuning: state.tuning,
             detuning: Q8_24::ZERO,
             motional: Phasor::ZERO,
             locked: false,
             rate_limited: false,
         };
-        if amplitude == Amplitude::ZERO {
-            self.previous_error_mhz = 0;
-            self.in_lock = 0;
+        if input.amplitude == Amplitude::ZERO {
+            state.previous_error_mhz = 0;
+            state.in_lock = 0;
             return Ok(status);
         }
-        if window.phasor.is_below(stack.min_current(amplitude)) {
-            self.without_current = self.without_current.saturating_add(1);
-            self.previous_error_mhz = 0;
-            self.in_lock = 0;
-            if self.without_current >= self.config.no_current_windows {
+        if input
+            .window
+            .phasor
+            .is_below(stack.min_current(input.amplitude))
+        {
+            state.without_current = state.without_current.saturating_add(1);
+            state.previous_error_mhz = 0;
+            state.in_lock = 0;
+            if state.without_current >= self.config.no_current_windows {
                 return Err(ResonanceFault::NoCurrent);
             }
             return Ok(status);
         }
-        self.without_current = 0;
-        let motional =
-            stack
-                .capacitance()
-                .motional(window.phasor, self.tuning.frequency, amplitude);
+        state.without_current = 0;
+        let motional = stack.capacitance().motional(
+            input.window.phasor,
+            state.tuning.frequency,
+            input.amplitude,
+        );
         let x = detuning(motional);
         // The error of the loop's own (fine) frequency: the measurement was made at the timer's
         // rounding of it, so estimate f0 = achieved - x f/2Q and compare the command with
@@ -321,47 +381,47 @@ impl Tracker {
         // (0.6 Hz near 40 kHz) into the proportional term as a +-Kp step square wave, which
         // the rate bound clips symmetrically into a limit cycle that stops following a drift.
         // |x| <= 16 in Q8.24 and the half-bandwidth < 2^25 mHz: the product fits easily.
-        let half_bandwidth = stack.half_bandwidth_mhz(self.tuning.frequency);
+        let half_bandwidth = stack.half_bandwidth_mhz(state.tuning.frequency);
         let measured = (i64::from(x.to_bits()) * i64::from(half_bandwidth) + (1 << 23)) >> 24;
-        let error = measured + self.command_mhz - i64::from(self.tuning.frequency.millihertz());
+        let error = measured + state.command_mhz - i64::from(state.tuning.frequency.millihertz());
         let config = &self.config;
-        let proportional = (i64::from(config.proportional_q30) * (error - self.previous_error_mhz)
-            + (1 << 29))
-            >> 30;
+        let proportional =
+            (i64::from(config.proportional_q30) * (error - state.previous_error_mhz) + (1 << 29))
+                >> 30;
         // Ki T, capped at 1 (2^48): a larger step gain would overshoot every step.
-        let gain = (config.integral_per_sample_q48 as u128 * u128::from(window.samples))
+        let gain = (config.integral_per_sample_q48 as u128 * u128::from(input.window.samples))
             .min(1 << 48) as i128;
         let integral = ((gain * i128::from(error) + (1 << 47)) >> 48) as i64;
         let wanted = -(proportional + integral);
-        let max_step = config.max_step_mhz(window.samples);
+        let max_step = config.max_step_mhz(input.window.samples);
         let step = wanted.clamp(-max_step, max_step);
-        let target = self.command_mhz + step;
+        let target = state.command_mhz + step;
         let command = clamp(target, config);
         // Pinned: at a limit, with the loop asking to go further out.
         if command != target && (wanted > 0) == (target > command) {
-            self.at_limit = self.at_limit.saturating_add(1);
+            state.at_limit = state.at_limit.saturating_add(1);
         } else {
-            self.at_limit = 0;
+            state.at_limit = 0;
         }
-        if self.at_limit >= config.limit_windows {
+        if state.at_limit >= config.limit_windows {
             return Err(ResonanceFault::AtFrequencyLimit);
         }
         if x.to_bits().unsigned_abs() <= config.lock_detuning.to_bits().unsigned_abs() {
-            self.in_lock = self.in_lock.saturating_add(1);
+            state.in_lock = state.in_lock.saturating_add(1);
         } else {
-            self.in_lock = 0;
+            state.in_lock = 0;
         }
         // The limits are in band, so the timer can always produce the clamped command.
         if let Ok(tuning) = Tuning::nearest(Frequency::from_millihertz(command as u32), self.clock)
         {
-            self.tuning = tuning;
-            self.command_mhz = command;
+            state.tuning = tuning;
+            state.command_mhz = command;
         }
-        self.previous_error_mhz = error;
-        status.tuning = self.tuning;
+        state.previous_error_mhz = error;
+        status.tuning = state.tuning;
         status.detuning = x;
         status.motional = motional;
-        status.locked = self.in_lock >= config.lock_windows;
+        status.locked = state.in_lock >= config.lock_windows;
         status.rate_limited = step != wanted;
         Ok(status)
     }

@@ -320,7 +320,7 @@ fn a_zero_amplitude_window_restarts_the_loop_as_new() {
     assert_eq!(tracker.tuning().frequency, before, "the frequency holds");
     let mut fresh = Tracker::new(
         config(&settings),
-        Frequency::from_millihertz(tracker.command_mhz as u32),
+        Frequency::from_millihertz(tracker.state.command_mhz as u32),
         CLOCK,
     )
     .unwrap();

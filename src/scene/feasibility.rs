@@ -475,6 +475,73 @@ fn sliding(scene: &Scene<'_>, settings: &Settings) -> Option<Finding> {
     worst
 }
 
+/// One instant of a target point's span at which the friction loop runs (sliding faster than
+/// the controller's `sliding_on_m_s`, under more than its `min_normal_force_n`), with what the
+/// target asks for there.
+struct TargetInstant {
+    /// Index of the target point whose span this is.
+    point: usize,
+    /// The instant, s: a point's span is judged up to just before the next point, whose own
+    /// target takes over at its time.
+    t_s: f64,
+    /// The target in force.
+    target: Target,
+    /// Sliding speed, m/s (magnitude).
+    speed_m_s: f64,
+    /// Normal load, N.
+    load_n: f64,
+    /// The natural friction coefficient at that speed.
+    mu: f64,
+    /// Friction ratio F'/F the target asks for ([`needed_ratio`]).
+    needed: f64,
+}
+
+/// The `SAMPLES + 1` instants of every target point's span (from the point to the next, the
+/// last to the scene's end) at which the loop runs: the one walk over the target spans that
+/// the reach and the noise checks share.
+fn loop_instants<'a>(
+    scene: &'a Scene<'a>,
+    settings: &'a Settings,
+) -> impl Iterator<Item = TargetInstant> + 'a {
+    scene
+        .target
+        .iter()
+        .enumerate()
+        .flat_map(move |(index, point)| {
+            let end = scene
+                .target
+                .get(index + 1)
+                .map_or(scene.duration_s, |next| next.at_s);
+            instants(point.at_s, end.max(point.at_s)).map(move |t| {
+                // Just before the next point its own target takes over.
+                let t = if t >= end && end > point.at_s {
+                    end - 1e-9
+                } else {
+                    t
+                };
+                (index, t)
+            })
+        })
+        .filter_map(move |(point, t_s)| {
+            let target = target_at(scene.target, t_s as f32)?;
+            let speed_m_s = speed_at(scene, t_s);
+            let load_n = f64::from(interpolate(scene.normal_load_n, t_s as f32));
+            if speed_m_s <= settings.sliding_on_m_s || load_n <= settings.min_normal_force_n {
+                return None;
+            }
+            let mu = scene.controller.natural_coefficient(speed_m_s);
+            Some(TargetInstant {
+                point,
+                t_s,
+                target,
+                speed_m_s,
+                load_n,
+                mu,
+                needed: needed_ratio(target, mu, load_n),
+            })
+        })
+}
+
 fn reach<M: FrictionModel + ?Sized>(
     scene: &Scene<'_>,
     settings: &Settings,
@@ -486,86 +553,72 @@ fn reach<M: FrictionModel + ?Sized>(
         Err(_) => return None,
     };
     let band = scene.accuracy.friction_pct / 100.0;
-    let threshold = settings.sliding_on_m_s;
     let mut worst: Option<(f64, Finding)> = None;
-    for (index, point) in scene.target.iter().enumerate() {
-        let end = scene
-            .target
-            .get(index + 1)
-            .map_or(scene.duration_s, |next| next.at_s);
-        for t in instants(point.at_s, end.max(point.at_s)) {
-            // Just before the next point its own target takes over.
-            let t = if t >= end && end > point.at_s {
-                end - 1e-9
-            } else {
-                t
-            };
-            let Some(target) = target_at(scene.target, t as f32) else {
-                continue;
-            };
-            // A net-force target (issue 27) is not a friction ratio: its reach is the motor
-            // hold's, which flags it while running (`crate::control::net_force`).
-            if target == (Target::Reduction { reduction_mpct: 0 }) || target.is_signed() {
-                continue;
+    for instant in loop_instants(scene, settings) {
+        let TargetInstant {
+            point: index,
+            t_s: t,
+            target,
+            speed_m_s: speed,
+            load_n: load,
+            needed,
+            ..
+        } = instant;
+        // A net-force target (issue 27) is not a friction ratio: its reach is the motor
+        // hold's, which flags it while running (`crate::control::net_force`).
+        if target == (Target::Reduction { reduction_mpct: 0 }) || target.is_signed() {
+            continue;
+        }
+        let drive = ceiling * drive_gain(scene, t);
+        let operating = OperatingPoint {
+            normal_force: Q16_16::from_f64_saturating(load).value,
+            sliding_velocity: Q8_24::from_f64_saturating(speed).value,
+        };
+        let amplitude = Q1_31::from_f64_saturating(drive).value;
+        let reachable = match model.ratio(&operating, amplitude) {
+            Ok(ratio) => ratio.to_f64(),
+            Err(error) => {
+                return Some(Finding {
+                    severity: Severity::Refuse,
+                    field: "controller",
+                    cause: Cause::Model(error),
+                });
             }
-            let speed = speed_at(scene, t);
-            let load = f64::from(interpolate(scene.normal_load_n, t as f32));
-            if speed <= threshold || load <= settings.min_normal_force_n {
-                continue;
-            }
-            let mu = scene.controller.natural_coefficient(speed);
-            let needed = needed_ratio(target, mu, load);
-            let drive = ceiling * drive_gain(scene, t);
-            let operating = OperatingPoint {
-                normal_force: Q16_16::from_f64_saturating(load).value,
-                sliding_velocity: Q8_24::from_f64_saturating(speed).value,
-            };
-            let amplitude = Q1_31::from_f64_saturating(drive).value;
-            let reachable = match model.ratio(&operating, amplitude) {
-                Ok(ratio) => ratio.to_f64(),
-                Err(error) => {
-                    return Some(Finding {
-                        severity: Severity::Refuse,
-                        field: "controller",
-                        cause: Cause::Model(error),
-                    });
-                }
-            };
-            // Relative miss of the friction: below reach (needed < reachable) or above the
-            // natural friction (needed > 1).
-            let miss = if needed < reachable {
-                (reachable - needed) / needed
-            } else if needed > 1.0 {
-                (needed - 1.0) / needed
-            } else {
-                continue;
-            };
-            let severity = if miss > band {
-                Severity::Refuse
-            } else {
-                Severity::Warn
-            };
-            let field = match target {
-                Target::Reduction { .. } => "profiles.target.reduction_pct",
-                Target::Coef { .. } => "profiles.target.coef",
-                Target::Force { .. } => "profiles.target.force_n",
-                Target::NetForce { .. } => "profiles.target.net_force_n",
-            };
-            let finding = Finding {
-                severity,
-                field,
-                cause: Cause::TargetOutOfReach {
-                    point: index,
-                    target,
-                    at_s: t,
-                    needed_ratio: needed,
-                    reachable_ratio: if needed > 1.0 { 1.0 } else { reachable },
-                    drive,
-                },
-            };
-            if worst.is_none_or(|(m, _)| miss > m) {
-                worst = Some((miss, finding));
-            }
+        };
+        // Relative miss of the friction: below reach (needed < reachable) or above the
+        // natural friction (needed > 1).
+        let miss = if needed < reachable {
+            (reachable - needed) / needed
+        } else if needed > 1.0 {
+            (needed - 1.0) / needed
+        } else {
+            continue;
+        };
+        let severity = if miss > band {
+            Severity::Refuse
+        } else {
+            Severity::Warn
+        };
+        let field = match target {
+            Target::Reduction { .. } => "profiles.target.reduction_pct",
+            Target::Coef { .. } => "profiles.target.coef",
+            Target::Force { .. } => "profiles.target.force_n",
+            Target::NetForce { .. } => "profiles.target.net_force_n",
+        };
+        let finding = Finding {
+            severity,
+            field,
+            cause: Cause::TargetOutOfReach {
+                point: index,
+                target,
+                at_s: t,
+                needed_ratio: needed,
+                reachable_ratio: if needed > 1.0 { 1.0 } else { reachable },
+                drive,
+            },
+        };
+        if worst.is_none_or(|(m, _)| miss > m) {
+            worst = Some((miss, finding));
         }
     }
     worst.map(|(_, finding)| finding)
@@ -598,54 +651,45 @@ fn noise(scene: &Scene<'_>, settings: &Settings) -> Option<Finding> {
     // mu0 is learned sliding with the drive off, from the sliding debounce until the drive
     // first starts (at least the controller's `natural_learn_s`).
     let mut learn_s: Option<f64> = None;
-    for (index, point) in scene.target.iter().enumerate() {
-        let end = scene
-            .target
-            .get(index + 1)
-            .map_or(scene.duration_s, |next| next.at_s);
-        for t in instants(point.at_s, end.max(point.at_s)) {
-            let Some(target) = target_at(scene.target, t as f32) else {
-                continue;
-            };
-            let speed = speed_at(scene, t);
-            let load = f64::from(interpolate(scene.normal_load_n, t as f32));
-            if speed <= settings.sliding_on_m_s || load <= settings.min_normal_force_n {
-                continue;
-            }
-            let mu = scene.controller.natural_coefficient(speed);
-            let needed = needed_ratio(target, mu, load);
-            // Natural friction is held with the drive off: the noise moves no drive.
-            if needed >= 1.0 {
-                continue;
-            }
-            let friction = needed * mu * load;
-            let learn_s = *learn_s.get_or_insert(libm::fmax(
-                t - settings.sliding_debounce_s,
-                settings.natural_learn_s,
+    for instant in loop_instants(scene, settings) {
+        let TargetInstant {
+            t_s: t,
+            load_n: load,
+            needed,
+            mu,
+            ..
+        } = instant;
+        // Natural friction is held with the drive off: the noise moves no drive.
+        if needed >= 1.0 {
+            continue;
+        }
+        let friction = needed * mu * load;
+        let learn_s = *learn_s.get_or_insert(libm::fmax(
+            t - settings.sliding_debounce_s,
+            settings.natural_learn_s,
+        ));
+        // Through the loop: the steady PI's share of the measured ratio's noise and mu0's
+        // learning error (`control::steady_noise_rms_error`).
+        let predicted = 100.0
+            * crate::control::steady_noise_rms_error(
+                settings, tangential, normal, friction, load, learn_s,
+            );
+        let field = if tangential / friction >= normal / load {
+            "sensors.tangential.noise_rms_pct_fs"
+        } else {
+            "sensors.normal.noise_rms_pct_fs"
+        };
+        if worst.is_none_or(|(p, _, _)| predicted > p) {
+            worst = Some((
+                predicted,
+                Cause::Noise {
+                    predicted_pct: predicted,
+                    band_pct: band,
+                    friction_n: friction,
+                    tangential_noise_n: tangential,
+                },
+                field,
             ));
-            // Through the loop: the steady PI's share of the measured ratio's noise and mu0's
-            // learning error (`control::steady_noise_rms_error`).
-            let predicted = 100.0
-                * crate::control::steady_noise_rms_error(
-                    settings, tangential, normal, friction, load, learn_s,
-                );
-            let field = if tangential / friction >= normal / load {
-                "sensors.tangential.noise_rms_pct_fs"
-            } else {
-                "sensors.normal.noise_rms_pct_fs"
-            };
-            if worst.is_none_or(|(p, _, _)| predicted > p) {
-                worst = Some((
-                    predicted,
-                    Cause::Noise {
-                        predicted_pct: predicted,
-                        band_pct: band,
-                        friction_n: friction,
-                        tangential_noise_n: tangential,
-                    },
-                    field,
-                ));
-            }
         }
     }
     let (predicted, cause, field) = worst?;

@@ -3,7 +3,7 @@
 use super::calibration::{Calibration, mean, rms_deviation};
 use super::error::SenseError;
 use super::fault::{FaultLimits, FaultMonitor, SensorFault};
-use super::format::AdcFormat;
+use super::format::{AdcCode, AdcFormat};
 use crate::fx::{Q1_31, Q16_16, Sat};
 
 /// What can go wrong with one sample.
@@ -43,7 +43,7 @@ impl SensorChannel {
 
     /// Checks and converts one raw code. The value is Q16.16 newtons or amperes, clamped with
     /// the flag set if out of range. Integer only (one 64-bit multiply plus comparisons).
-    pub fn process(&mut self, code: i32) -> Result<Sat<Q16_16>, SampleError> {
+    pub fn process(&mut self, code: AdcCode) -> Result<Sat<Q16_16>, SampleError> {
         let reading = self.format.normalize(code).map_err(SampleError::Code)?;
         self.monitor.check(reading).map_err(SampleError::Fault)?;
         Ok(self.calibration.apply(reading))
@@ -54,7 +54,7 @@ impl SensorChannel {
     /// steady, so what moves is the cell's and the converter's noise, quantisation included):
     /// [`Self::noise`]. Errors: `InvalidFormat` for no codes, `CodeOutOfRange` for a code the
     /// converter cannot produce.
-    pub fn tare(&mut self, codes: &[i32]) -> Result<(), SenseError> {
+    pub fn tare(&mut self, codes: &[AdcCode]) -> Result<(), SenseError> {
         let zero = self.mean_reading(codes)?;
         let readings = codes
             .iter()
@@ -79,13 +79,13 @@ impl SensorChannel {
     /// Sets the span so that the mean of `codes`, taken under `load` (Q16.16 newtons), reads
     /// `load`. Tare first. Errors: those of [`Self::tare`] and
     /// [`Calibration::with_known_load`].
-    pub fn calibrate_gain(&mut self, codes: &[i32], load: Q16_16) -> Result<(), SenseError> {
+    pub fn calibrate_gain(&mut self, codes: &[AdcCode], load: Q16_16) -> Result<(), SenseError> {
         let loaded = self.mean_reading(codes)?;
         self.calibration = self.calibration.with_known_load(loaded, load)?;
         Ok(())
     }
 
-    fn mean_reading(&self, codes: &[i32]) -> Result<Q1_31, SenseError> {
+    fn mean_reading(&self, codes: &[AdcCode]) -> Result<Q1_31, SenseError> {
         for &code in codes {
             self.format.normalize(code)?;
         }
@@ -138,14 +138,21 @@ mod tests {
     #[test]
     fn tare_and_gain_from_bursts_of_codes() {
         let mut cell = channel();
-        cell.tare(&[33_000, 33_002, 32_998, 33_000]).unwrap();
-        assert_eq!(cell.process(33_000), Ok(Sat::exact(Q16_16::ZERO)));
-        // 20 N makes the reading rise by 1311 LSB.
-        cell.calibrate_gain(&[34_311, 34_311], Q16_16::from_int_const(20))
+        cell.tare(&[33_000, 33_002, 32_998, 33_000].map(AdcCode::new))
             .unwrap();
-        let value = cell.process(34_311).unwrap();
+        assert_eq!(
+            cell.process(AdcCode::new(33_000)),
+            Ok(Sat::exact(Q16_16::ZERO))
+        );
+        // 20 N makes the reading rise by 1311 LSB.
+        cell.calibrate_gain(
+            &[34_311, 34_311].map(AdcCode::new),
+            Q16_16::from_int_const(20),
+        )
+        .unwrap();
+        let value = cell.process(AdcCode::new(34_311)).unwrap();
         assert!((value.value.to_f64() - 20.0).abs() < 1e-3);
-        let half = cell.process(33_656).unwrap().value.to_f64();
+        let half = cell.process(AdcCode::new(33_656)).unwrap().value.to_f64();
         assert!((half - 10.0).abs() < 0.02, "{half}");
     }
 
@@ -156,14 +163,14 @@ mod tests {
         // +-8 codes of the 16-bit result about 33 000: 8 / 65 536 of full scale, 500 N per full
         // scale: 0.061 N RMS.
         let burst: [i32; 64] = core::array::from_fn(|k| if k % 2 == 0 { 32_992 } else { 33_008 });
-        cell.tare(&burst).unwrap();
+        cell.tare(&burst.map(AdcCode::new)).unwrap();
         let noise = cell.noise().unwrap().to_f64();
         assert!((noise - 500.0 * 8.0 / 65_536.0).abs() < 1e-4, "{noise}");
         // A quiet burst reads one lsb, not zero; a burst four times as noisy, four times.
-        cell.tare(&[33_000; 16]).unwrap();
+        cell.tare(&[33_000; 16].map(AdcCode::new)).unwrap();
         assert_eq!(cell.noise(), Some(Q16_16::from_bits(1)));
         let loud: [i32; 64] = core::array::from_fn(|k| if k % 2 == 0 { 32_968 } else { 33_032 });
-        cell.tare(&loud).unwrap();
+        cell.tare(&loud.map(AdcCode::new)).unwrap();
         let ratio = cell.noise().unwrap().to_f64() / noise;
         assert!((ratio - 4.0).abs() < 1e-3, "{ratio}");
     }
@@ -172,20 +179,20 @@ mod tests {
     fn bad_codes_and_faults_are_told_apart() {
         let mut cell = channel();
         assert_eq!(
-            cell.process(65_521),
+            cell.process(AdcCode::new(65_521)),
             Err(SampleError::Code(SenseError::CodeOutOfRange {
                 code: 65_521
             }))
         );
         assert!(matches!(
-            cell.process(65_520),
+            cell.process(AdcCode::new(65_520)),
             Err(SampleError::Fault(SensorFault::HighRail { .. }))
         ));
         cell.reset_faults();
-        assert!(cell.process(30_000).is_ok());
+        assert!(cell.process(AdcCode::new(30_000)).is_ok());
         assert_eq!(cell.tare(&[]), Err(SenseError::InvalidFormat));
         assert_eq!(
-            cell.tare(&[1, -5]),
+            cell.tare(&[1, -5].map(AdcCode::new)),
             Err(SenseError::CodeOutOfRange { code: -5 })
         );
         // A failed tare leaves the calibration alone.

@@ -134,7 +134,7 @@ impl FaultMonitor {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sense::format::Oversampling;
+    use crate::sense::format::{AdcCode, Oversampling};
 
     /// The board's internal ADC channels: 12 bits, 16x oversampled, 16-bit result.
     fn adc16() -> AdcFormat {
@@ -160,7 +160,10 @@ mod tests {
         let format = adc16();
         let mut monitor = FaultMonitor::new(format, limits());
         for i in 0..10_000 {
-            assert_eq!(monitor.check(format.normalize(healthy(i)).unwrap()), Ok(()));
+            assert_eq!(
+                monitor.check(format.normalize(AdcCode::new(healthy(i))).unwrap()),
+                Ok(())
+            );
         }
     }
 
@@ -168,18 +171,18 @@ mod tests {
     fn a_disconnected_cell_reads_at_a_rail() {
         let format = adc16();
         let mut monitor = FaultMonitor::new(format, limits());
-        let top = format.normalize(65_520).unwrap();
+        let top = format.normalize(AdcCode::new(65_520)).unwrap();
         assert_eq!(
             monitor.check(top),
             Err(SensorFault::HighRail { reading: top })
         );
         let mut monitor = FaultMonitor::new(format, limits());
-        let near_zero = format.normalize(100).unwrap(); // 0.15 % FS, inside the margin
+        let near_zero = format.normalize(AdcCode::new(100)).unwrap(); // 0.15 % FS, inside the margin
         assert_eq!(
             monitor.check(near_zero),
             Err(SensorFault::LowRail { reading: near_zero })
         );
-        let just_off = format.normalize(140).unwrap(); // 0.21 % FS
+        let just_off = format.normalize(AdcCode::new(140)).unwrap(); // 0.21 % FS
         assert_eq!(monitor.check(just_off), Ok(()));
     }
 
@@ -189,10 +192,10 @@ mod tests {
         let mut monitor = FaultMonitor::new(format, limits());
         for i in 0..100 {
             monitor
-                .check(format.normalize(healthy(i)).unwrap())
+                .check(format.normalize(AdcCode::new(healthy(i))).unwrap())
                 .unwrap();
         }
-        let frozen = format.normalize(31_000).unwrap();
+        let frozen = format.normalize(AdcCode::new(31_000)).unwrap();
         for _ in 0..49 {
             assert_eq!(monitor.check(frozen), Ok(()));
         }
@@ -201,20 +204,23 @@ mod tests {
             Err(SensorFault::Stuck { samples: 50 })
         );
         // Still within the band (2 LSB) keeps it stuck; movement clears it.
-        let wobble = format.normalize(31_002).unwrap();
+        let wobble = format.normalize(AdcCode::new(31_002)).unwrap();
         assert_eq!(
             monitor.check(wobble),
             Err(SensorFault::Stuck { samples: 51 })
         );
-        assert_eq!(monitor.check(format.normalize(31_010).unwrap()), Ok(()));
+        assert_eq!(
+            monitor.check(format.normalize(AdcCode::new(31_010)).unwrap()),
+            Ok(())
+        );
     }
 
     #[test]
     fn an_implausible_jump_is_reported_once() {
         let format = adc16();
         let mut monitor = FaultMonitor::new(format, limits());
-        let before = format.normalize(30_000).unwrap();
-        let after = format.normalize(30_000 + 4097).unwrap(); // just over 1/16 FS
+        let before = format.normalize(AdcCode::new(30_000)).unwrap();
+        let after = format.normalize(AdcCode::new(30_000 + 4097)).unwrap(); // just over 1/16 FS
         monitor.check(before).unwrap();
         assert_eq!(
             monitor.check(after),
@@ -225,14 +231,14 @@ mod tests {
         );
         // The next sample continues from the new level.
         assert_eq!(
-            monitor.check(format.normalize(30_000 + 4100).unwrap()),
+            monitor.check(format.normalize(AdcCode::new(30_000 + 4100)).unwrap()),
             Ok(())
         );
         // A step of exactly the limit is plausible.
         let mut monitor = FaultMonitor::new(format, limits());
         monitor.check(before).unwrap();
         assert_eq!(
-            monitor.check(format.normalize(30_000 + 4096).unwrap()),
+            monitor.check(format.normalize(AdcCode::new(30_000 + 4096)).unwrap()),
             Ok(())
         );
     }
@@ -241,15 +247,20 @@ mod tests {
     fn rails_win_over_jumps_and_reset_forgets_history() {
         let format = adc16();
         let mut monitor = FaultMonitor::new(format, limits());
-        monitor.check(format.normalize(32_000).unwrap()).unwrap();
-        let zero = format.normalize(0).unwrap();
+        monitor
+            .check(format.normalize(AdcCode::new(32_000)).unwrap())
+            .unwrap();
+        let zero = format.normalize(AdcCode::new(0)).unwrap();
         assert_eq!(
             monitor.check(zero),
             Err(SensorFault::LowRail { reading: zero })
         );
         monitor.reset();
         // Without history a far-away reading is not a jump.
-        assert_eq!(monitor.check(format.normalize(10_000).unwrap()), Ok(()));
+        assert_eq!(
+            monitor.check(format.normalize(AdcCode::new(10_000)).unwrap()),
+            Ok(())
+        );
     }
 
     #[test]
@@ -262,11 +273,11 @@ mod tests {
                 ..limits()
             },
         );
-        let constant = format.normalize(-1_000_000).unwrap();
+        let constant = format.normalize(AdcCode::new(-1_000_000)).unwrap();
         for _ in 0..1000 {
             assert_eq!(monitor.check(constant), Ok(()));
         }
-        let bottom = format.normalize(-0x80_0000).unwrap();
+        let bottom = format.normalize(AdcCode::new(-0x80_0000)).unwrap();
         assert_eq!(
             monitor.check(bottom),
             Err(SensorFault::LowRail { reading: bottom })

@@ -43,6 +43,32 @@ impl Oversampling {
     }
 }
 
+/// One raw converter code, as the converter delivers it: a G4 ADC word (12 bits, or up to 16
+/// from its hardware oversampler, unsigned) or an ADS131M02 word (24-bit two's complement,
+/// sign-extended). Its width and full scale are its channel's [`AdcFormat`], which refuses a
+/// code the converter cannot produce; [`AdcFormat::normalize`] is the one conversion to a
+/// fraction of full scale and [`crate::sense::SensorChannel::process`] the one to newtons.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AdcCode(i32);
+
+impl AdcCode {
+    /// The code `raw` (any `i32`: the format says which are possible).
+    pub const fn new(raw: i32) -> Self {
+        Self(raw)
+    }
+
+    /// The code of an unsigned 16-bit converter word (a G4 ADC data register).
+    pub const fn from_word(word: u16) -> Self {
+        Self(word as i32)
+    }
+
+    /// The raw code.
+    pub const fn raw(self) -> i32 {
+        self.0
+    }
+}
+
 /// The code range of one converter channel and how to scale it to a fraction of full scale.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -106,18 +132,19 @@ impl AdcFormat {
     }
 
     /// The smallest code the converter produces.
-    pub const fn min_code(self) -> i32 {
-        self.min_code
+    pub const fn min_code(self) -> AdcCode {
+        AdcCode(self.min_code)
     }
 
     /// The largest code the converter produces.
-    pub const fn max_code(self) -> i32 {
-        self.max_code
+    pub const fn max_code(self) -> AdcCode {
+        AdcCode(self.max_code)
     }
 
     /// `code` as a fraction of full scale, Q1.31. Error `CodeOutOfRange` for a code the
     /// converter cannot produce (a corrupted transfer, a wrong format).
-    pub const fn normalize(self, code: i32) -> Result<Q1_31, SenseError> {
+    pub const fn normalize(self, code: AdcCode) -> Result<Q1_31, SenseError> {
+        let code = code.0;
         if code < self.min_code || code > self.max_code {
             return Err(SenseError::CodeOutOfRange { code });
         }
@@ -139,6 +166,22 @@ impl AdcFormat {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_converter_word_is_its_code_without_a_sign() {
+        // The G4's 16-bit word is unsigned: the top word is 65 535, never -1.
+        assert_eq!(AdcCode::from_word(0).raw(), 0);
+        assert_eq!(AdcCode::from_word(u16::MAX).raw(), 65_535);
+        let sixteen = AdcFormat::unipolar(16).unwrap();
+        assert_eq!(sixteen.max_code(), AdcCode::from_word(u16::MAX));
+        assert!(sixteen.normalize(AdcCode::from_word(u16::MAX)).is_ok());
+        // 12 bits summed over 16 top out at 65 520: the words above it are refused.
+        let summed = AdcFormat::oversampled(12, Oversampling::new(4, 0).unwrap()).unwrap();
+        assert_eq!(
+            summed.normalize(AdcCode::from_word(65_521)),
+            Err(SenseError::CodeOutOfRange { code: 65_521 })
+        );
+    }
 
     #[test]
     fn oversampling_fields_follow_the_register_encoding() {
@@ -163,29 +206,32 @@ mod tests {
         let avg16 = AdcFormat::oversampled(12, Oversampling::new(4, 4).unwrap()).unwrap();
         let mid16 = AdcFormat::oversampled(12, Oversampling::new(4, 2).unwrap()).unwrap();
         let half = Q1_31::from_bits(1 << 30);
-        assert_eq!(plain.normalize(2048), Ok(half));
-        assert_eq!(sum16.normalize(32_768), Ok(half));
-        assert_eq!(avg16.normalize(2048), Ok(half));
-        assert_eq!(mid16.normalize(8192), Ok(half));
-        assert_eq!(sum16.max_code(), 65_520);
-        assert_eq!(avg16.max_code(), 4095);
-        assert_eq!(mid16.max_code(), 16_380);
+        assert_eq!(plain.normalize(AdcCode::new(2048)), Ok(half));
+        assert_eq!(sum16.normalize(AdcCode::new(32_768)), Ok(half));
+        assert_eq!(avg16.normalize(AdcCode::new(2048)), Ok(half));
+        assert_eq!(mid16.normalize(AdcCode::new(8192)), Ok(half));
+        assert_eq!(sum16.max_code().raw(), 65_520);
+        assert_eq!(avg16.max_code().raw(), 4095);
+        assert_eq!(mid16.max_code().raw(), 16_380);
     }
 
     #[test]
     fn bipolar_24_bit_spans_minus_one_to_one() {
         let ads = AdcFormat::bipolar(24).unwrap();
-        assert_eq!(ads.normalize(-0x80_0000), Ok(Q1_31::MIN));
-        assert_eq!(ads.normalize(0x7F_FFFF), Ok(Q1_31::from_bits(0x7FFF_FF00)));
-        assert_eq!(ads.normalize(-1), Ok(Q1_31::from_bits(-256)));
+        assert_eq!(ads.normalize(AdcCode::new(-0x80_0000)), Ok(Q1_31::MIN));
+        assert_eq!(
+            ads.normalize(AdcCode::new(0x7F_FFFF)),
+            Ok(Q1_31::from_bits(0x7FFF_FF00))
+        );
+        assert_eq!(ads.normalize(AdcCode::new(-1)), Ok(Q1_31::from_bits(-256)));
         assert_eq!(ads.min_normalized(), Q1_31::MIN);
         assert_eq!(
-            ads.normalize(0x80_0000),
+            ads.normalize(AdcCode::new(0x80_0000)),
             Err(SenseError::CodeOutOfRange { code: 0x80_0000 })
         );
         let full = AdcFormat::bipolar(32).unwrap();
-        assert_eq!(full.normalize(i32::MIN), Ok(Q1_31::MIN));
-        assert_eq!(full.normalize(i32::MAX), Ok(Q1_31::MAX));
+        assert_eq!(full.normalize(AdcCode::new(i32::MIN)), Ok(Q1_31::MIN));
+        assert_eq!(full.normalize(AdcCode::new(i32::MAX)), Ok(Q1_31::MAX));
     }
 
     #[test]
@@ -207,11 +253,11 @@ mod tests {
         );
         let twelve = AdcFormat::unipolar(12).unwrap();
         assert_eq!(
-            twelve.normalize(4096),
+            twelve.normalize(AdcCode::new(4096)),
             Err(SenseError::CodeOutOfRange { code: 4096 })
         );
         assert_eq!(
-            twelve.normalize(-1),
+            twelve.normalize(AdcCode::new(-1)),
             Err(SenseError::CodeOutOfRange { code: -1 })
         );
         assert_eq!(twelve.max_normalized(), Q1_31::from_bits(4095 << 19));

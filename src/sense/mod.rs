@@ -22,5 +22,5 @@ pub use calibration::{Calibration, mean};
 pub use channel::{SampleError, SensorChannel};
 pub use error::SenseError;
 pub use fault::{FaultLimits, FaultMonitor, SensorFault};
-pub use format::{AdcFormat, Oversampling};
+pub use format::{AdcCode, AdcFormat, Oversampling};
 pub use front_end::{BridgeAmplifier, ShuntAmplifier};

@@ -33,7 +33,7 @@ pub fn capture(station: &Station, scene: &str, cal_count: u32) -> Record {
 struct NoBench;
 
 impl CellBench for NoBench {
-    fn burst(&mut self, _axis: Axis, _load_n: f32, _codes: &mut [i32]) -> bool {
+    fn burst(&mut self, _axis: Axis, _load_n: f32, _codes: &mut [crate::sense::AdcCode]) -> bool {
         false
     }
 }

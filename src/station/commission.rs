@@ -169,28 +169,29 @@ impl Station {
             fault: output.fault.is_some(),
         };
         let amplitude = match sequence.control(&inputs) {
-            Phase::Search => resonance.search_amplitude().command(),
-            Phase::Drive(amplitude) => amplitude,
+            Phase::Search => resonance.search_amplitude(),
+            Phase::Drive(amplitude) => Amplitude::from_command(amplitude),
             Phase::DriveOffPinned => {
                 let here = resonance.tuning().frequency;
                 let _ = resonance.pin(here);
-                Q1_31::ZERO
+                Amplitude::ZERO
             }
-            Phase::Off => Q1_31::ZERO,
+            Phase::Off => Amplitude::ZERO,
             Phase::Done(result) => {
                 let result = result.and_then(|r| self.apply_commission(&r).map(|()| r));
                 if result.is_err() {
                     self.pin_here();
                 }
                 self.commission.last = LastCommission::Finished(result);
-                Q1_31::ZERO
+                Amplitude::ZERO
             }
         };
         if output.fault.is_none() {
             output.amplitude = amplitude;
-            self.controller.drive_replaced(amplitude);
+            // A search at full scale is the controller's largest Q1.31 (2^-31 low).
+            self.controller.drive_replaced(amplitude.command().value);
         }
-        self.applied = Amplitude::from_command(output.amplitude);
+        self.applied = output.amplitude;
     }
 
     /// The loop on the measured values, all or nothing ([`commissioned_settings`]): the

@@ -26,7 +26,6 @@
 
 use sonolube::control::Output;
 use sonolube::drive::{Amplitude, DriveError, DriveLimits, DriveTiming, Frequency};
-use sonolube::fx::{Q1_31, Q2_30};
 use sonolube::protocol::SupervisorState;
 
 pub use crate::drive_fit::DriveRefusal;
@@ -118,7 +117,7 @@ impl Bridge {
             return Ok(());
         }
         // A search the station does not drive (stopped meanwhile) leaves the bridge off.
-        let search_drives = searching && output.amplitude > Q1_31::ZERO;
+        let search_drives = searching && output.amplitude > Amplitude::ZERO;
         let drives = (search_drives
             || matches!(
                 output.state,
@@ -184,13 +183,14 @@ impl Bridge {
         }
     }
 
-    /// The controller's `amplitude` (Q1.31 of the scene's full scale) as the bridge's, capped.
-    fn bridge_amplitude(&self, amplitude: Q1_31) -> Amplitude {
-        let command = i64::from(amplitude.to_bits().max(0));
-        // Q1.31 x Q2.30 >> 31 = Q2.30; at most 2^30 (both factors at most 1).
-        let bits = ((command * self.scale_q30 + (1 << 30)) >> 31).clamp(0, 1 << 30);
-        let bits = i32::try_from(bits).unwrap_or(0);
-        Amplitude::new(Q2_30::from_bits(bits))
+    /// The controller's `amplitude` (of the scene's full scale) as the bridge's, capped.
+    fn bridge_amplitude(&self, amplitude: Amplitude) -> Amplitude {
+        // Unsigned Q1.31 x Q2.30 >> 30 = unsigned Q1.31; at most 2^31 (both factors at most
+        // 1), so `from_bits` cannot refuse it (a refusal would be no drive, never a wrap).
+        let bits = (i64::from(amplitude.bits()) * self.scale_q30 + (1 << 29)) >> 30;
+        u32::try_from(bits)
+            .ok()
+            .and_then(|bits| Amplitude::from_bits(bits).ok())
             .unwrap_or(Amplitude::ZERO)
             .min(self.ceiling)
     }

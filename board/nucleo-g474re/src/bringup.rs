@@ -36,8 +36,8 @@ impl HoldToRun {
         defmt::warn!(
             "BRING-UP BUILD: holding B1 switches the bridge at amplitude {=u32}/1024 \
              (ceiling {=u32}/1024)",
-            config::BRINGUP_AMPLITUDE.bits() >> 20,
-            ceiling.bits() >> 20
+            config::BRINGUP_AMPLITUDE.bits() >> 21,
+            ceiling.bits() >> 21
         );
         Self {
             button: Input::new(button, Pull::Down),

@@ -23,7 +23,7 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use sonolube::protocol::Axis;
-use sonolube::sense::{AdcFormat, FaultLimits};
+use sonolube::sense::{AdcCode, AdcFormat, FaultLimits};
 use sonolube::station::COMMISSIONING_SAMPLES;
 
 use crate::config;
@@ -99,7 +99,7 @@ fn rails(format: AdcFormat, limits: FaultLimits) -> (u16, u16) {
     let high = i64::from(format.max_normalized().to_bits()) - margin;
     // The code of a normalized value: divide by one code's fraction.
     let one = format
-        .normalize(1)
+        .normalize(AdcCode::new(1))
         .map_or(1, |q| i64::from(q.to_bits()).max(1));
     let low_code = (low / one).clamp(0, i64::from(u16::MAX));
     let high_code = ((high + one - 1) / one).clamp(0, i64::from(u16::MAX));
@@ -179,7 +179,7 @@ impl CellFeed {
     /// switched during any of them (a vibrating contact loads the cells), when `fresh` is false
     /// (sensing has stopped, the history is old) or when one of them is at the real
     /// converter's rail.
-    pub fn burst(&self, axis: Axis, fresh: bool, codes: &mut [i32]) -> bool {
+    pub fn burst(&self, axis: Axis, fresh: bool, codes: &mut [AdcCode]) -> bool {
         let wanted = codes.len();
         let Ok(wanted_u32) = u32::try_from(wanted) else {
             return false;
@@ -208,7 +208,7 @@ impl CellFeed {
                 defmt::warn!("cells: {} cell at its rail during the burst", axis);
                 return false;
             }
-            *slot = i32::from(real);
+            *slot = AdcCode::from_word(real);
         }
         true
     }

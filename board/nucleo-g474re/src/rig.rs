@@ -31,7 +31,7 @@ use sonolube::control::{ExternalFault, Reason};
 use sonolube::drive::Frequency;
 use sonolube::protocol::{Axis, Command, DRIVE_FREQ, ProtocolError, SupervisorState, TokenText};
 use sonolube::resonance::LockState;
-use sonolube::sense::{Calibration, SenseError, SensorChannel};
+use sonolube::sense::{AdcCode, Calibration, SenseError, SensorChannel};
 use sonolube::station::{CellBench, MAX_CURRENT_SAMPLES, Sample, Station, StationError};
 use sonolube_app::control::ControlLoop;
 use sonolube_app::snapshot::Snapshot;
@@ -377,7 +377,7 @@ struct Bench<'a> {
 }
 
 impl CellBench for Bench<'_> {
-    fn burst(&mut self, axis: Axis, _load_n: f32, codes: &mut [i32]) -> bool {
+    fn burst(&mut self, axis: Axis, _load_n: f32, codes: &mut [AdcCode]) -> bool {
         self.feed.burst(axis, self.fresh, codes)
     }
 }
@@ -398,9 +398,12 @@ impl ControlLoop for BoardRig {
         let (pair, held) = self.feed.take(drive::outputs_enabled());
         let (normal_code, tangential_code) = if held > setup.stale_after_steps {
             // No pair for too long: the converter reads as disconnected (low rail).
-            (0, 0)
+            (AdcCode::new(0), AdcCode::new(0))
         } else {
-            (pair.normal, pair.tangential)
+            (
+                AdcCode::from_word(pair.normal),
+                AdcCode::from_word(pair.tangential),
+            )
         };
         let control = setup.station.control(&Sample {
             normal_code,

@@ -6,7 +6,7 @@ use embassy_stm32::peripherals::{ADC1, DMA1_CH1, PA0, PA1, PA8, PB0, PB13, TIM1}
 use embassy_stm32::{Peri, pac};
 use embassy_time::{Duration, Instant};
 use sonolube::drive::{Amplitude, DriveLimits, DriveTiming, OvercurrentTrip};
-use sonolube::sense::{Calibration, SampleError, SensorChannel};
+use sonolube::sense::{AdcCode, Calibration, SampleError, SensorChannel};
 
 use crate::cells::{self, RawPair};
 use crate::overcurrent::{self, OvercurrentGuard, Thresholds};
@@ -148,14 +148,14 @@ pub async fn run(hw: Hardware) {
     // The first triplets, with the drive off, are the current sense's zero (an overrun only
     // loses samples).
     let mut block: Block = [0; CHANNELS * SCANS_PER_READ];
-    let mut zero_codes = [0i32; TARE_TRIPLETS];
+    let mut zero_codes = [AdcCode::default(); TARE_TRIPLETS];
     let mut taken = 0;
     while taken < TARE_TRIPLETS {
         if ring.read(&mut block).await.is_ok()
             && let (Some(slot), Some([_, _, current])) =
                 (zero_codes.get_mut(taken), sensing::combine(&block))
         {
-            *slot = i32::from(current);
+            *slot = AdcCode::from_word(current);
             taken += 1;
         }
     }
@@ -196,7 +196,7 @@ pub async fn run(hw: Hardware) {
                 Ok(_) => match sensing::combine(&block) {
                     Some(triplet) => {
                         for (i, &code) in triplet.iter().enumerate() {
-                            let fault = logs[i].record(&mut channels[i], i32::from(code));
+                            let fault = logs[i].record(&mut channels[i], AdcCode::from_word(code));
                             // A saturated or disconnected current sense stops the drive at once and
                             // keeps the control loop from switching it on; load-cell faults are the
                             // control loop's business (its station checks the codes itself).
@@ -240,7 +240,7 @@ pub async fn run(hw: Hardware) {
 /// near the nominal zero, and moves the trip threshold with it.
 fn tare_current(
     current: &mut SensorChannel,
-    codes: &[i32],
+    codes: &[AdcCode],
     nominal: &Calibration,
     guard: &mut OvercurrentGuard,
 ) {
@@ -287,17 +287,17 @@ fn log_timing(timing: &DriveTiming) {
     defmt::info!(
         "drive: at amplitude {=u32}/1024, CH1 high {=u32} ns, CH1N high {=u32} ns per period; \
          pulses vanish below amplitude {=u32}/1024",
-        amplitude.bits() >> 20,
+        amplitude.bits() >> 21,
         timing.high_side_on_ns(amplitude),
         timing.low_side_on_ns(amplitude),
-        timing.min_effective_amplitude().bits() >> 20
+        timing.min_effective_amplitude().bits() >> 21
     );
     // The ratings' ceiling at this frequency (f64 once, at configuration).
     match DriveLimits::new(&config::STACK, config::FULL_SCALE_V) {
         Ok(limits) => defmt::info!(
             "drive: amplitude ceiling {=u32}/1024 at this frequency (stack 15.466 V, 1.75 A; \
              full scale {=u32} mV); at full scale CH1 high {=u32} ns",
-            limits.max_amplitude(timing.frequency()).bits() >> 20,
+            limits.max_amplitude(timing.frequency()).bits() >> 21,
             (config::FULL_SCALE_V * 1000.0) as u32,
             timing.high_side_on_ns(Amplitude::FULL)
         ),

@@ -17,7 +17,7 @@ use embassy_stm32::pac;
 use embassy_stm32::peripherals::{ADC1, DMA1_CH1, PA0, PA1, PB0};
 use embassy_stm32::triggers::TIM1_CC3;
 use sonolube::fx::{Q1_31, Q16_16};
-use sonolube::sense::{SampleError, SensorChannel};
+use sonolube::sense::{AdcCode, SampleError, SensorChannel};
 use sonolube_g474_hw::adc as plan;
 use static_cell::StaticCell;
 
@@ -130,8 +130,8 @@ impl ChannelLog {
     }
 
     /// Runs `code` through `channel` and records the outcome. Returns the fault, if any.
-    pub fn record(&mut self, channel: &mut SensorChannel, code: i32) -> Option<SampleError> {
-        self.code_sum += i64::from(code);
+    pub fn record(&mut self, channel: &mut SensorChannel, code: AdcCode) -> Option<SampleError> {
+        self.code_sum += i64::from(code.raw());
         self.samples = self.samples.saturating_add(1);
         match channel.process(code) {
             Ok(value) => {

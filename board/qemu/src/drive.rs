@@ -5,12 +5,12 @@
 //! reads at the start of every period ([`crate::rig`]). So a drive forced safe by a panic, a
 //! watchdog NMI or a fault is exactly what the plant sees next.
 
-use core::sync::atomic::{AtomicBool, AtomicI32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
-use sonolube::fx::Q1_31;
+use sonolube::drive::Amplitude;
 
-/// Drive amplitude command, Q1.31 fraction of full scale in [0, 1) (0 = off).
-static AMPLITUDE: AtomicI32 = AtomicI32::new(0);
+/// Drive amplitude command, [`Amplitude`]'s bits (unsigned Q1.31, 2^31 = full scale; 0 = off).
+static AMPLITUDE: AtomicU32 = AtomicU32::new(0);
 /// Whether the output stage is enabled.
 static ENABLED: AtomicBool = AtomicBool::new(false);
 
@@ -19,8 +19,8 @@ static ENABLED: AtomicBool = AtomicBool::new(false);
 pub struct DriveState {
     /// Output stage enabled.
     pub enabled: bool,
-    /// Amplitude command, Q1.31 of full scale.
-    pub amplitude_q31: i32,
+    /// Amplitude command, [`Amplitude`]'s bits (unsigned Q1.31, 2^31 = full scale).
+    pub amplitude_bits: u32,
 }
 
 /// Puts the drive output in its safe state: stage disabled, amplitude zero. Callable from any
@@ -30,10 +30,9 @@ pub fn force_safe() {
     AMPLITUDE.store(0, Ordering::SeqCst);
 }
 
-/// Sets the amplitude command (Q1.31, negative values count as zero); the stage is enabled
-/// while it is above zero.
-pub fn set(amplitude: Q1_31) {
-    let bits = amplitude.to_bits().max(0);
+/// Sets the amplitude command; the stage is enabled while it is above zero.
+pub fn set(amplitude: Amplitude) {
+    let bits = amplitude.bits();
     AMPLITUDE.store(bits, Ordering::SeqCst);
     ENABLED.store(bits != 0, Ordering::SeqCst);
 }
@@ -42,7 +41,7 @@ pub fn set(amplitude: Q1_31) {
 pub fn state() -> DriveState {
     DriveState {
         enabled: ENABLED.load(Ordering::SeqCst),
-        amplitude_q31: AMPLITUDE.load(Ordering::SeqCst),
+        amplitude_bits: AMPLITUDE.load(Ordering::SeqCst),
     }
 }
 
@@ -50,7 +49,8 @@ pub fn state() -> DriveState {
 /// is disabled.
 pub fn plant_input() -> f32 {
     if ENABLED.load(Ordering::SeqCst) {
-        Q1_31::from_bits(AMPLITUDE.load(Ordering::SeqCst)).to_f32()
+        // Only `set` stores, from an `Amplitude`: the bits are in range.
+        Amplitude::from_bits(AMPLITUDE.load(Ordering::SeqCst)).map_or(0.0, Amplitude::to_f32)
     } else {
         0.0
     }

@@ -114,7 +114,7 @@ impl SimulatedRig {
         match built {
             Ok(run) => {
                 *self.run = run;
-                drive::set(sonolube::fx::Q1_31::ZERO);
+                drive::set(sonolube::drive::Amplitude::ZERO);
                 self.log_commissioned();
             }
             Err(error) => {

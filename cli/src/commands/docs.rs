@@ -100,6 +100,16 @@ pub const BLOCKS: &[Block] = &[
         cost: Cost::Seconds,
     },
     Block {
+        name: "dahl-round-trip",
+        run: "cargo test --quiet --release -p sonolube-cli --test dahl_table --test inverse_round_trip -- --nocapture --test-threads 1 2>&1 | sed -E 's/^[.]+//' | grep -E '^T=[0-9]+x[0-9]+: max error|^round trip over|: [0-9]+ targets, worst'",
+        show: None,
+        fence: true,
+        cost: Cost::Slow {
+            why: "a test build of the command-line crate",
+            fresh: &[],
+        },
+    },
+    Block {
         name: "commission-host",
         run: "sonolube scene resonance-search --commission | grep -E '^  commissioned:'",
         show: None,

@@ -41,6 +41,7 @@ use sonolube::model::motor::HornRegion;
 use sonolube::model::{AnyModel, FrictionModel, ModelError};
 use sonolube::protocol::Target;
 use sonolube::scene::{Channel, FaultKind, Scene};
+use sonolube::sense::AdcCode;
 
 /// Why a plant could not be built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -98,9 +99,9 @@ pub struct SensorReadings {
     /// Steps taken so far (1 after the first step).
     pub step: u32,
     /// Normal-load cell, ADC code, 0 ..= 2^bits - 1 (zero force at mid-scale).
-    pub normal_code: u16,
+    pub normal_code: AdcCode,
     /// Tangential (friction) cell, ADC code, 0 ..= 2^bits - 1 (zero force at mid-scale).
-    pub tangential_code: u16,
+    pub tangential_code: AdcCode,
     /// Sliding velocity from the carriage encoder, m/s, signed (exact).
     pub sliding_velocity_m_per_s: f32,
     /// Drive current at the drive frequency (for the resonance tracker).

@@ -44,7 +44,7 @@ fn the_same_scene_and_inputs_give_the_same_run() {
             ra.truth.contact.friction_n.to_bits(),
             rb.truth.contact.friction_n.to_bits()
         );
-        seen_codes[usize::from(ra.tangential_code)] = true;
+        seen_codes[usize::try_from(ra.tangential_code.raw()).unwrap()] = true;
     }
     // The noise is live: many different codes, not a constant.
     assert!(seen_codes.iter().filter(|&&seen| seen).count() > 20);
@@ -99,8 +99,8 @@ fn quiet_cells_read_the_true_forces() {
     let mut plant = Plant::from_scene(&scene).expect("plant");
     let readings = plant.step(0.0, 40_000.0);
     // 4.155 N on 10 N full scale: 2048 + 0.4155 x 2048 = 2898.9; 0.831 N on 2 N: 2898.9.
-    assert_eq!(readings.normal_code, 2899);
-    assert_eq!(readings.tangential_code, 2899);
+    assert_eq!(readings.normal_code, AdcCode::new(2899));
+    assert_eq!(readings.tangential_code, AdcCode::new(2899));
     // Driven, the friction falls and the cell follows within its 2 kHz bandwidth.
     let mut last = readings;
     for _ in 0..100 {
@@ -108,8 +108,11 @@ fn quiet_cells_read_the_true_forces() {
     }
     let cell = LoadCellSim::new(&scene.tangential_cell, 1.0, 0.0);
     let expected = cell.convert(last.truth.contact.friction_n);
-    assert!(last.tangential_code.abs_diff(expected) <= 1, "{last:?}");
-    assert!(last.tangential_code < 2600);
+    assert!(
+        last.tangential_code.raw().abs_diff(i32::from(expected)) <= 1,
+        "{last:?}"
+    );
+    assert!(last.tangential_code < AdcCode::new(2600));
     assert_eq!(last.sliding_velocity_m_per_s, 0.038);
 }
 
@@ -121,30 +124,36 @@ fn a_disconnected_cell_reads_the_rail_from_the_onset() {
     for k in 1..=200u32 {
         let readings = plant.step(0.5, 40_000.0);
         let faulted = k >= 150;
-        assert_eq!(readings.tangential_code == 4095, faulted, "step {k}");
+        assert_eq!(
+            readings.tangential_code == AdcCode::new(4095),
+            faulted,
+            "step {k}"
+        );
         assert_eq!(
             readings.truth.tangential_fault.is_some(),
             faulted,
             "step {k}"
         );
-        assert!(readings.normal_code > 2700 && readings.normal_code < 3100);
+        assert!(
+            readings.normal_code > AdcCode::new(2700) && readings.normal_code < AdcCode::new(3100)
+        );
     }
 }
 
 #[test]
 fn a_spike_lasts_one_sample_and_a_stuck_cell_freezes() {
     let mut plant = Plant::from_scene(&scene("sensor-spike")).expect("plant");
-    let codes: [u16; 130] = core::array::from_fn(|_| plant.step(0.5, 40_000.0).tangential_code);
+    let codes: [AdcCode; 130] = core::array::from_fn(|_| plant.step(0.5, 40_000.0).tangential_code);
     // +1.5 N on 2 N full scale is +1536 codes, at sample 120 only (index 119).
     assert!(
-        codes[119] > codes[118] + 1300,
-        "{} after {}",
+        codes[119].raw() > codes[118].raw() + 1300,
+        "{:?} after {:?}",
         codes[119],
         codes[118]
     );
-    assert!(codes[120] < codes[118] + 100);
+    assert!(codes[120].raw() < codes[118].raw() + 100);
     let mut plant = Plant::from_scene(&scene("sensor-stuck")).expect("plant");
-    let codes: [u16; 200] = core::array::from_fn(|_| plant.step(0.5, 40_000.0).normal_code);
+    let codes: [AdcCode; 200] = core::array::from_fn(|_| plant.step(0.5, 40_000.0).normal_code);
     // Frozen from sample 120 at the code of sample 119, while the noise moved it before.
     assert!(codes[119..].iter().all(|&code| code == codes[118]));
     assert!(codes[..118].windows(2).any(|w| w[0] != w[1]));

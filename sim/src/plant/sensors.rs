@@ -18,6 +18,7 @@ use core::f32::consts::TAU;
 
 use super::noise::Gaussian;
 use sonolube::scene::{FaultKind, LoadCell, Rail};
+use sonolube::sense::AdcCode;
 
 /// One simulated load cell and its converter channel.
 #[derive(Debug, Clone, PartialEq)]
@@ -70,8 +71,9 @@ impl LoadCellSim {
         self.filtered_n
     }
 
-    /// Samples the converter: one noise draw from `noise`, then `fault` if one is active.
-    pub fn sample(&mut self, noise: &mut Gaussian, fault: Option<FaultKind>) -> u16 {
+    /// Samples the converter: one noise draw from `noise`, then `fault` if one is active. The
+    /// code is the cell's converter word (unipolar, `adc_bits` wide).
+    pub fn sample(&mut self, noise: &mut Gaussian, fault: Option<FaultKind>) -> AdcCode {
         let draw = noise.sample();
         let reading = self.gain * self.filtered_n + self.offset_n + self.noise_rms_n * draw;
         let code = match fault {
@@ -85,7 +87,7 @@ impl LoadCellSim {
             self.stuck_code = None;
         }
         self.last_code = code;
-        code
+        AdcCode::from_word(code)
     }
 
     /// Converter code of a reading (N): mid-scale for zero, saturating at both ends.
@@ -97,9 +99,10 @@ impl LoadCellSim {
     }
 
     /// Nominal force of a code, N (the datasheet calibration): (code - zero) / zero x FS.
-    pub fn nominal_force_n(&self, code: u16) -> f32 {
+    pub fn nominal_force_n(&self, code: AdcCode) -> f32 {
         let zero = f32::from(self.zero_code);
-        (f32::from(code) - zero) / zero * self.full_scale_n
+        // A cell's code has at most 16 bits: exact in f32.
+        (code.raw() as f32 - zero) / zero * self.full_scale_n
     }
 }
 
@@ -135,8 +138,8 @@ mod tests {
         assert_eq!(cell.convert(-2.0), 0);
         assert_eq!(cell.convert(-50.0), 0);
         assert_eq!(cell.convert(f32::NAN), 0);
-        assert_eq!(cell.nominal_force_n(3072), 1.0);
-        assert_eq!(cell.nominal_force_n(2048), 0.0);
+        assert_eq!(cell.nominal_force_n(AdcCode::new(3072)), 1.0);
+        assert_eq!(cell.nominal_force_n(AdcCode::new(2048)), 0.0);
     }
 
     #[test]
@@ -183,7 +186,7 @@ mod tests {
         let mut sim = LoadCellSim::new(&cell, SUBSTEP, 1.0);
         let mut noise = Gaussian::from_seed(1);
         // 1.05 x 1 N + 0.1 N = 1.15 N: 2048 + 1.15 / 2 x 2048 = 3225.6.
-        assert_eq!(sim.sample(&mut noise, None), 3226);
+        assert_eq!(sim.sample(&mut noise, None), AdcCode::new(3226));
     }
 
     #[test]
@@ -216,9 +219,9 @@ mod tests {
         let mut noise = Gaussian::from_seed(1);
         let high = FaultKind::Disconnected { rail: Rail::High };
         let low = FaultKind::Disconnected { rail: Rail::Low };
-        assert_eq!(sim.sample(&mut noise, Some(high)), 4095);
-        assert_eq!(sim.sample(&mut noise, Some(low)), 0);
-        assert_eq!(sim.sample(&mut noise, None), 2560);
+        assert_eq!(sim.sample(&mut noise, Some(high)), AdcCode::new(4095));
+        assert_eq!(sim.sample(&mut noise, Some(low)), AdcCode::new(0));
+        assert_eq!(sim.sample(&mut noise, None), AdcCode::new(2560));
     }
 
     #[test]
@@ -230,7 +233,7 @@ mod tests {
         let mut sim = LoadCellSim::new(&cell, SUBSTEP, 0.5);
         let mut noise = Gaussian::from_seed(3);
         let before = sim.sample(&mut noise, None);
-        let stuck: [u16; 20] = core::array::from_fn(|_| {
+        let stuck: [AdcCode; 20] = core::array::from_fn(|_| {
             sim.track(1.5);
             sim.sample(&mut noise, Some(FaultKind::Stuck))
         });
@@ -240,7 +243,7 @@ mod tests {
             sim.track(1.5);
         }
         let live = sim.sample(&mut noise, None);
-        assert!((f32::from(live) - 3584.0).abs() < 60.0, "{live}");
+        assert!((live.raw() as f32 - 3584.0).abs() < 60.0, "{live:?}");
         // A new stuck episode freezes the new value.
         let again = sim.sample(&mut noise, Some(FaultKind::Stuck));
         assert_eq!(again, live);
@@ -251,10 +254,10 @@ mod tests {
         let mut sim = LoadCellSim::new(&CELL, SUBSTEP, 0.5);
         let mut noise = Gaussian::from_seed(1);
         let spike = FaultKind::Spike { force_n: 1.0 };
-        assert_eq!(sim.sample(&mut noise, Some(spike)), 3584);
-        assert_eq!(sim.sample(&mut noise, None), 2560);
+        assert_eq!(sim.sample(&mut noise, Some(spike)), AdcCode::new(3584));
+        assert_eq!(sim.sample(&mut noise, None), AdcCode::new(2560));
         // A spike past the range saturates.
         let big = FaultKind::Spike { force_n: -4.0 };
-        assert_eq!(sim.sample(&mut noise, Some(big)), 0);
+        assert_eq!(sim.sample(&mut noise, Some(big)), AdcCode::new(0));
     }
 }
