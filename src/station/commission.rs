@@ -7,7 +7,7 @@ use super::Station;
 use crate::commission::{
     CellZero, CommissionResult, Commissioning, PeriodInputs, Phase, Refusal, Step, check,
 };
-use crate::control::{Config, Output, Settings, tuned};
+use crate::control::{Config, Output, Settings, drive_lead_s, tuned};
 use crate::drive::{Amplitude, Frequency};
 use crate::fx::{Q1_31, Q16_16};
 use crate::protocol::{Command, ProtocolError, SupervisorState};
@@ -20,14 +20,21 @@ use crate::sense::{Calibration, SensorChannel};
 pub(super) struct CommissionState {
     last: LastCommission,
     applied: Option<CommissionResult>,
+    /// The scene's tightest overshoot criterion ([`crate::control::overshoot_criterion`]):
+    /// the lead on the measured envelope is bounded by it as the declared tuning's is.
+    overshoot: Option<f64>,
 }
 
 impl CommissionState {
-    /// No `commission` given, the declared values.
-    pub(super) const NEVER: Self = Self {
-        last: LastCommission::Never,
-        applied: None,
-    };
+    /// No `commission` given, the declared values, for a scene whose tightest overshoot
+    /// criterion is `overshoot` (fraction of the step).
+    pub(super) const fn never(overshoot: Option<f64>) -> Self {
+        Self {
+            last: LastCommission::Never,
+            applied: None,
+            overshoot,
+        }
+    }
 }
 
 /// The state of the last `commission`.
@@ -201,7 +208,7 @@ impl Station {
     fn apply_commission(&mut self, result: &CommissionResult) -> Result<(), Refusal> {
         let refused = |reason| Refusal::new(Step::Natural, reason, f64::NAN);
         check(result)?;
-        let settings = commissioned_settings(&self.settings, result)
+        let settings = commissioned_settings(&self.settings, result, self.commission.overshoot)
             .map_err(|_| refused("controller refused the values"))?;
         let config =
             Config::new(&settings).map_err(|_| refused("controller refused the values"))?;
@@ -263,22 +270,26 @@ impl Station {
     }
 }
 
-/// `settings` on the commissioned values: the envelope time constant tau (and the lead, which
-/// cannot make it slower: `min(reference lead, tau)`, the rule of
+/// `settings` on the commissioned values: the envelope time constant tau (and the lead on it,
+/// [`drive_lead_s`]: bounded for the settings' declared mismatch under the scene's tightest
+/// overshoot criterion `overshoot`, never slower than tau; the rule of
 /// [`crate::control::controller_settings`]), the drive frequency f0 (the current ceiling),
 /// mu0 as the prior of the natural coefficient, the contact's relaxation lag scaled with it
 /// (the slip length `mu W / k_t` is proportional to mu: [`crate::control::contact_lag_s`]),
 /// each cell's measured noise where the tare measured it, then the tuning rule
-/// ([`tuned`]) for the gains on all of them. Errors: the rule refused a value.
+/// ([`tuned`]) for the gains on all of them. The declared mismatch (`settings.model_mismatch`,
+/// the scene's) is kept: commissioning measures f0, Q, mu0 and the noise, not the model's
+/// error. Errors: the rule refused a value.
 pub fn commissioned_settings(
     settings: &Settings,
     result: &CommissionResult,
+    overshoot: Option<f64>,
 ) -> Result<Settings, crate::control::ConfigError> {
     let mut s = *settings;
     let tau = result.time_constant_s.value;
     let mu0 = result.natural_coefficient.value;
     s.envelope_time_constant_s = tau;
-    s.response_time_constant_s = libm::fmin(Settings::REFERENCE.response_time_constant_s, tau);
+    s.response_time_constant_s = drive_lead_s(&s, overshoot);
     s.actuator.drive_frequency_hz = result.resonance_hz.value;
     if s.natural_prior > 0.0 {
         s.contact_lag_s *= mu0 / s.natural_prior;
