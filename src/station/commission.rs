@@ -7,7 +7,9 @@ use super::Station;
 use crate::commission::{
     CellZero, CommissionResult, Commissioning, PeriodInputs, Phase, Refusal, Step, check,
 };
-use crate::control::{Config, Output, Settings, drive_lead_s, tuned};
+use crate::control::{
+    Config, GainSchedule, Output, Settings, ShaperConfig, drive_lead_s, gain_schedule, tuned,
+};
 use crate::drive::{Amplitude, Frequency};
 use crate::fx::{Q1_31, Q16_16};
 use crate::protocol::{Command, ProtocolError, SupervisorState};
@@ -54,8 +56,10 @@ enum LastCommission {
 
 /// Putting a commissioning result into the loop, one stage per control period: the tuning
 /// rule on the measured values ([`commissioned_settings`]: square roots, a logarithm,
-/// divisions), then the controller's fixed-point configuration from them ([`Config::new`]:
-/// the filters' cosines and exponentials, the gain schedule), then the swap. Done in the one
+/// divisions), then the controller's gain schedule ([`gain_schedule`]), then its drive shaper
+/// on the measured envelope ([`ShaperConfig::new`]), then the rest of its configuration from
+/// the running one ([`Config::commissioned`]: the contact lag, the ceiling at f0, mu0's
+/// prior; the force filters and the rest are unchanged), then the swap. Done in the one
 /// period the sequence ended in, the three made that period the only one of a console
 /// `commission` to overrun in the QEMU serve mode (a control part of 5,861 SysTick cycles,
 /// 145 us past its deadline at 10 kHz; `scripts/qemu-settings-test reset`'s commissioning
@@ -64,8 +68,13 @@ enum LastCommission {
 enum ApplyStage {
     /// Next: the settings on the measured values.
     Settings,
-    /// Next: the configuration of these settings.
-    Config(Settings),
+    /// Next: the gain schedule of these settings.
+    Gains(Settings),
+    /// Next: the drive shaper of these settings (the measured envelope and the lead).
+    Shaper(Settings, GainSchedule),
+    /// Next: the rest of the configuration of these settings, from the running one
+    /// ([`Config::commissioned`]).
+    Config(Settings, GainSchedule, ShaperConfig),
     /// Next: swap these into the controller, pin the drive at f0.
     Install(Settings, Config),
 }
@@ -245,9 +254,24 @@ impl Station {
         let next = match stage {
             ApplyStage::Settings => self
                 .commission_settings(&result)
-                .map(|settings| Some(ApplyStage::Config(settings))),
-            ApplyStage::Config(settings) => commission_config(&settings)
-                .map(|config| Some(ApplyStage::Install(settings, config))),
+                .map(|settings| Some(ApplyStage::Gains(settings))),
+            ApplyStage::Gains(settings) => gain_schedule(&settings)
+                .map(|gains| Some(ApplyStage::Shaper(settings, gains)))
+                .map_err(|_| refused_by_controller()),
+            ApplyStage::Shaper(settings, gains) => ShaperConfig::new(
+                settings.envelope_time_constant_s,
+                settings.response_time_constant_s,
+                settings.slew_full_scale_s,
+                settings.period_s,
+            )
+            .map(|shaper| Some(ApplyStage::Config(settings, gains, shaper)))
+            .map_err(|_| refused_by_controller()),
+            ApplyStage::Config(settings, gains, shaper) => self
+                .controller
+                .config()
+                .commissioned(&settings, gains, shaper)
+                .map(|config| Some(ApplyStage::Install(settings, config)))
+                .map_err(|_| refused_by_controller()),
             ApplyStage::Install(settings, config) => self
                 .install_commission(&result, settings, config)
                 .map(|()| None),
