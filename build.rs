@@ -326,6 +326,7 @@ fn leak_scene(d: scene_toml::SceneDescription) -> scene::Scene<'static> {
         criteria: &d.criteria,
         contents: d.contents,
         commission: d.commission,
+        model_mismatch: d.model_mismatch,
     }
 }
 

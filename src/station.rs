@@ -260,7 +260,7 @@ impl Station {
             current_sense: false,
             no_current_reason: NO_CURRENT_ON_BOARD,
             applied: Amplitude::ZERO,
-            commission: CommissionState::NEVER,
+            commission: CommissionState::never(crate::control::overshoot_criterion(scene)),
             reach: reach::ReachWatch::new(reach::ReachWatch::window_s(settings), settings.period_s),
             last_estimate: None,
             nominal_resonance_hz: scene.transducer.resonance_hz,

@@ -81,6 +81,7 @@ impl LoadedScene {
             criteria: &d.criteria,
             contents: d.contents,
             commission: d.commission,
+            model_mismatch: d.model_mismatch,
         }
     }
 }

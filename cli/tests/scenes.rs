@@ -385,6 +385,58 @@ fn a_scene_may_ask_for_commissioning_and_its_run_uses_the_measured_values() {
     assert!(scene_toml::parse(&wrong, "edited.toml").is_err());
 }
 
+/// `[controller] model_mismatch_pct` is the user's declaration: absent it is `None` (the
+/// tuning's default), given it loads as a fraction into the compiled scene type, the loop's
+/// settings take it; out of range or in `[plant]` it is refused with the value and why.
+#[test]
+fn the_declared_mismatch_is_read_from_the_controller_table() {
+    let text = reference_text();
+    assert_eq!(
+        scene_toml::parse(&text, "reference.toml")
+            .expect("loads")
+            .model_mismatch,
+        None
+    );
+    let with_key = text.replacen(
+        "k_t_n_per_m = 2.5e7",
+        "k_t_n_per_m = 2.5e7\nmodel_mismatch_pct = 35.0",
+        1,
+    );
+    let description = scene_toml::parse(&with_key, "edited.toml").expect("loads");
+    assert_eq!(description.model_mismatch, Some(0.35));
+    let loaded = LoadedScene::from_description(description);
+    let scene = loaded.scene();
+    assert_eq!(scene.model_mismatch, Some(0.35));
+    let settings = sonolube::control::controller_settings(&scene);
+    assert_eq!(settings.model_mismatch, 0.35);
+    for (pct, reason) in [
+        ("100.0", "outside 0 <= m < 100"),
+        ("-1.0", "outside 0 <= m < 100"),
+        ("nan", "outside 0 <= m < 100"),
+    ] {
+        let error = error_after(
+            "k_t_n_per_m = 2.5e7",
+            &format!("k_t_n_per_m = 2.5e7\nmodel_mismatch_pct = {pct}"),
+        );
+        assert_eq!(error.key, "controller.model_mismatch_pct", "{error}");
+        assert!(error.reason.contains(reason), "{error}");
+        // The value itself (f64's Display: 100, -1, NaN).
+        assert!(
+            error
+                .reason
+                .to_lowercase()
+                .starts_with(pct.trim_end_matches(".0")),
+            "{error}"
+        );
+    }
+    let error = error_after(
+        "dahl_alpha = 1.0",
+        "dahl_alpha = 1.0\nmodel_mismatch_pct = 20.0",
+    );
+    assert_eq!(error.key, "plant.model_mismatch_pct", "{error}");
+    assert!(error.reason.contains("[controller]"), "{error}");
+}
+
 /// The error for `text` with `from` replaced by `to`, as `key: reason`.
 fn error_after(from: &str, to: &str) -> scene_toml::SceneError {
     let text = reference_text();

@@ -74,6 +74,7 @@ fn scene_literal(s: &SceneDescription) -> String {
     field("criteria", slice(&s.criteria, criterion));
     field("contents", contents(&s.contents));
     field("commission", s.commission.to_string());
+    field("model_mismatch", option_num(s.model_mismatch));
     out.push_str(" }");
     out
 }

@@ -42,6 +42,8 @@ pub(crate) struct RawModel {
     pub k_t_n_per_m: Option<f64>,
     pub dahl_alpha: Option<f64>,
     pub surface: Option<RawSurface>,
+    /// `[controller]` only: the mismatch the user declares, %.
+    pub model_mismatch_pct: Option<f64>,
 }
 
 /// `[controller.surface]` and `[plant.surface]`.

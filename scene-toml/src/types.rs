@@ -57,6 +57,9 @@ pub struct SceneDescription {
     pub target: Vec<TargetPoint>,
     /// The run uses commissioned f0, Q and mu0 (`commission = true`; default false).
     pub commission: bool,
+    /// The declared model mismatch, fraction in [0, 1) (`[controller] model_mismatch_pct` /
+    /// 100); `None` without the key (the tuning's default then).
+    pub model_mismatch: Option<f64>,
     /// Accuracy needs.
     pub accuracy: Accuracy,
     /// Pass criteria.

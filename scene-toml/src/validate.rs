@@ -122,6 +122,7 @@ pub(crate) fn scene(raw: RawScene, errors: Errors<'_>) -> Result<SceneDescriptio
              dahl on both sides is allowed: the plant integrates the law in time)",
         ));
     }
+    let model_mismatch = declared_mismatch(errors, &raw)?;
     let mismatch = Mismatch {
         mu_ratio: plant.mu / controller.mu,
         k_t_ratio: controller
@@ -168,6 +169,7 @@ pub(crate) fn scene(raw: RawScene, errors: Errors<'_>) -> Result<SceneDescriptio
         sliding_velocity_m_per_s: Vec::new(),
         target: Vec::new(),
         commission: raw.commission.unwrap_or(false),
+        model_mismatch,
         accuracy: tables::accuracy(errors, &raw.accuracy)?,
         criteria: Vec::new(),
         contents: tables::contents(errors, &raw.contents)?,
@@ -179,6 +181,35 @@ pub(crate) fn scene(raw: RawScene, errors: Errors<'_>) -> Result<SceneDescriptio
         &raw.faults,
         &raw.criteria,
     )
+}
+
+/// `[controller] model_mismatch_pct` as a fraction: the share by which the user declares the
+/// plant's friction reduction may differ from the controller model's, which the tuning designs
+/// the loop for (`sonolube::control::controller_settings`). `None` without the key. Refused:
+/// outside 0 <= m < 100 (at 100 % the model would predict nothing of the reduction: the tuning
+/// divides by 1 - m), and in `[plant]`, whose parameters are the truth, not a belief.
+fn declared_mismatch(errors: Errors<'_>, raw: &RawScene) -> Result<Option<f64>, SceneError> {
+    if let Some(value) = raw.plant.model_mismatch_pct {
+        return Err(errors.at(
+            "plant.model_mismatch_pct",
+            format!(
+                "{value} given in [plant]: the mismatch is the user's declaration about the \
+                 controller's model; write it in [controller]"
+            ),
+        ));
+    }
+    match raw.controller.model_mismatch_pct {
+        None => Ok(None),
+        Some(pct) if pct.is_finite() && (0.0..100.0).contains(&pct) => Ok(Some(pct / 100.0)),
+        Some(pct) => Err(errors.at(
+            "controller.model_mismatch_pct",
+            format!(
+                "{pct} is outside 0 <= m < 100: the tuning designs for a plant whose friction \
+                 reduction is (1 - m) to (1 + m) times the model's, and at 100 % or more the \
+                 model predicts none of it"
+            ),
+        )),
+    }
 }
 
 fn text(errors: Errors<'_>, key: &str, value: &str, max: usize) -> Result<(), SceneError> {

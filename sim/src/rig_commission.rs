@@ -197,6 +197,65 @@ mod console {
 }
 
 #[cfg(test)]
+mod console_mismatch {
+    use super::*;
+    use sonolube::control::Settings;
+    use sonolube::scene::find;
+
+    /// The declared and the console-commissioned settings of `scene`'s rig.
+    fn console_commissioned(scene: &Scene<'_>) -> (Settings, Settings) {
+        let mut rig = ClosedLoop::operated(&rig_scene(scene)).expect("operated");
+        let declared = *rig.station().settings();
+        start_rig_commission(&mut rig).expect("started");
+        let limit = libm::ceil(RIG_LIMIT_S * scene.control_rate_hz) as u32;
+        for _ in 0..limit {
+            rig.step();
+            if let Some(outcome) = rig_commission_outcome(&rig) {
+                outcome.expect("accepted");
+                return (declared, *rig.station().settings());
+            }
+        }
+        panic!("the sequence did not end");
+    }
+
+    /// The console's `commission` keeps the mismatch the scene declares (commissioning does
+    /// not measure the model's error) and the scene's 5 % overshoot criterion, so its steps are
+    /// staged by them as the declared tuning's are (`(1 + 0.05) / (1 + m)` of a step at once:
+    /// 0.875 at the default 20 %, 0.75 at a declared 40 %), and its lead on the measured
+    /// envelope is the declared tuning's rule (`drive_lead_s`; the console path ran the
+    /// baseline's 0.25 ms before, whatever the criterion). The fast gain keeps its cap
+    /// `(1 - m - kp) / T`.
+    #[test]
+    fn a_console_commission_designs_for_the_declared_mismatch() {
+        let reference = find("reference").expect("built in");
+        for (declared_mismatch, expected_mismatch) in [(None, 0.2), (Some(0.4), 0.4)] {
+            let scene = Scene {
+                model_mismatch: declared_mismatch,
+                ..*reference
+            };
+            let (declared, s) = console_commissioned(&scene);
+            assert_eq!(declared.model_mismatch, expected_mismatch);
+            assert_eq!(s.model_mismatch, expected_mismatch);
+            assert_eq!(s.step_overshoot, Some(0.05));
+            assert_eq!(
+                s.response_time_constant_s,
+                sonolube::control::drive_lead_s(&s, Some(0.05)),
+                "{declared_mismatch:?}"
+            );
+            assert_eq!(
+                s.response_time_constant_s,
+                declared.response_time_constant_s
+            );
+            assert!(
+                s.ki_fast_per_s <= (1.0 - expected_mismatch - s.kp_fast) / s.period_s + 1e-9,
+                "{}",
+                s.ki_fast_per_s
+            );
+        }
+    }
+}
+
+#[cfg(test)]
 mod refusals {
     use super::*;
     use sonolube::commission::Step;

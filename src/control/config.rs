@@ -246,6 +246,24 @@ fn positive(value: f64, setting: &'static str) -> Result<f64, ConfigError> {
     }
 }
 
+/// The prediction's contact-lag stage for a lag of `contact_lag_s` at `period`: none for a
+/// lag whose step decays below 2^-31 within one period (tau < T / (31 ln 2)), the identity at
+/// the prediction's Q2.30 resolution: no stage, no cost.
+fn contact_lag_stage(contact_lag_s: f64, period: f64) -> Result<Option<LowPassCoef>, ConfigError> {
+    if contact_lag_s == 0.0
+        || (contact_lag_s > 0.0 && contact_lag_s * 31.0 * core::f64::consts::LN_2 < period)
+    {
+        Ok(None)
+    } else {
+        LowPassCoef::from_time_constant(contact_lag_s, period)
+            .map(Some)
+            .map_err(|error| ConfigError::Filter {
+                setting: "contact_lag_s",
+                error,
+            })
+    }
+}
+
 /// Steps of `duration_s`, rounded, at least one, saturating.
 fn steps(duration_s: f64, period_s: f64) -> u32 {
     libm::round(duration_s / period_s).clamp(1.0, u32::MAX as f64) as u32
@@ -336,20 +354,7 @@ impl Config {
                 period,
             )
             .map_err(ConfigError::Shaper)?,
-            // A lag whose step decays below 2^-31 within one period (tau < T / (31 ln 2)) is
-            // the identity at the prediction's Q2.30 resolution: no stage, no cost.
-            contact_lag: if s.contact_lag_s == 0.0
-                || (s.contact_lag_s > 0.0
-                    && s.contact_lag_s * 31.0 * core::f64::consts::LN_2 < period)
-            {
-                None
-            } else {
-                let lag = LowPassCoef::from_time_constant(s.contact_lag_s, period);
-                Some(lag.map_err(|error| ConfigError::Filter {
-                    setting: "contact_lag_s",
-                    error,
-                })?)
-            },
+            contact_lag: contact_lag_stage(s.contact_lag_s, period)?,
             sensor_lag: if s.sensor_lag_s == 0.0 {
                 None
             } else {
@@ -370,6 +375,40 @@ impl Config {
             },
             limit: AmplitudeLimit::new(&s.actuator).map_err(ConfigError::Limits)?,
             actuator: s.actuator,
+        })
+    }
+
+    /// This configuration on `settings` that differ from the ones it was built from only in
+    /// what commissioning measures (`crate::station::commissioned_settings`): the envelope and
+    /// lead time constants (`shaper`, [`ShaperConfig::new`] of them, computed before), the
+    /// contact lag, the natural coefficient's prior, the drive frequency (the ceiling) and the
+    /// gains (`gains`, [`gain_schedule`] of `settings`, computed before). Equal to
+    /// [`Config::new`] of `settings` under that condition, at a fraction of its cost (the
+    /// force and speed filters, the sensor lag, the ranges and ramps are kept), so that the
+    /// station can put a `commission` result into the loop within control periods. Errors: as
+    /// [`Config::new`] for the values it recomputes.
+    pub fn commissioned(
+        &self,
+        settings: &Settings,
+        gains: GainSchedule,
+        shaper: ShaperConfig,
+    ) -> Result<Self, ConfigError> {
+        let s = settings;
+        let prior = positive(s.natural_prior, "natural_prior")?;
+        let prior = Q2_30::from_f64(prior).map_err(|_| ConfigError::OutOfRange {
+            setting: "natural_prior",
+        })?;
+        Ok(Self {
+            natural: NaturalConfig {
+                prior,
+                ..self.natural
+            },
+            shaper,
+            contact_lag: contact_lag_stage(s.contact_lag_s, self.period_s)?,
+            gains,
+            limit: AmplitudeLimit::new(&s.actuator).map_err(ConfigError::Limits)?,
+            actuator: s.actuator,
+            ..*self
         })
     }
 

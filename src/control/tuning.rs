@@ -77,10 +77,18 @@ pub const NATURAL_LEARN_S: f64 = 3e-3;
 /// reference scene's steady RMS error goes from 0.68 % to 0.69 %.
 pub const STEADY_GAINS: (f64, f64) = (0.1, 300.0);
 
-/// The model's mismatch the tuning assumes when the user declares none: the plant's friction
+/// The model's mismatch the tuning assumes when the user declares none (a scene without
+/// `[controller] model_mismatch_pct`, [`Scene::model_mismatch`]): the plant's friction
 /// reduction may differ from the model's by +-20 % (the acceptance scene's mu x1.2 and k_t
 /// x0.8, and the mismatch grid's range).
 pub const DECLARED_MODEL_MISMATCH: f64 = 0.2;
+
+/// The mismatch `scene` declares (`[controller] model_mismatch_pct` / 100), or
+/// [`DECLARED_MODEL_MISMATCH`] without the key: what every part of the tuning designs for (the
+/// fast gain's rule [`tuned`], the lead [`drive_lead_s`], the slowest contact lag).
+pub fn declared_mismatch(scene: &Scene<'_>) -> f64 {
+    scene.model_mismatch.unwrap_or(DECLARED_MODEL_MISMATCH)
+}
 
 /// The time constant of a compliant contact's friction transient, s: a Dahl contact (alpha 1,
 /// seed 003 eqs 5-7) relaxes its friction over the slip length `mu W / k_t`, covered at the
@@ -163,6 +171,24 @@ pub fn staged_response_time_constant_s(
 /// The largest lead gain a staged step's lead is given: below the Q8.24 format's 128 with a
 /// margin for its rounding.
 pub const MAX_STAGED_LEAD_GAIN: f64 = 127.0;
+
+/// The drive's lead for the settings `s`, s, under the overshoot criterion `overshoot` (the
+/// scene's tightest, [`overshoot_criterion`]): with a criterion each step's feedforward is
+/// staged by the declared mismatch (`Settings::step_overshoot`), so the lead asks the envelope
+/// for the staged amplitude within one control period ([`staged_response_time_constant_s`]);
+/// without one the baseline's 0.25 ms. Never slower than the envelope
+/// `s.envelope_time_constant_s` itself (the lead cannot make it slower). The declared tuning
+/// ([`controller_settings`]) and the console's commissioning
+/// (`crate::station::commissioned_settings`, on the measured envelope) both take it.
+pub fn drive_lead_s(s: &Settings, overshoot: Option<f64>) -> f64 {
+    let envelope = s.envelope_time_constant_s;
+    let unstaged = if envelope > 0.0 {
+        libm::fmin(Settings::REFERENCE.response_time_constant_s, envelope)
+    } else {
+        Settings::REFERENCE.response_time_constant_s
+    };
+    staged_response_time_constant_s(overshoot, s.period_s, unstaged, envelope)
+}
 
 /// The tightest overshoot criterion of `scene`, as a fraction of the step; `None` without one.
 pub fn overshoot_criterion(scene: &Scene<'_>) -> Option<f64> {
@@ -397,6 +423,8 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
     let envelope = scene.transducer.envelope_time_constant_s();
     let (kp, ki_per_s) = STEADY_GAINS;
     let declared_noise = |cell: &LoadCell| cell.noise_rms_pct_fs / 100.0 * cell.full_scale_n;
+    // The user's mismatch ([`declared_mismatch`]), the default when the scene declares none.
+    let mismatch = declared_mismatch(scene);
     let settings = Settings {
         period_s: scene.control_period_s(),
         normal_bandwidth_hz: FORCE_FILTER_HZ,
@@ -430,7 +458,7 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
             scene.controller.k_t_n_per_m,
             scene.normal_load_n.first().map_or(0.0, |p| p.value),
             start_speed,
-        ) / (1.0 - DECLARED_MODEL_MISMATCH),
+        ) / (1.0 - mismatch),
         // The soft start's ceiling rises full scale in one envelope time constant
         // ([`soft_start_full_scale_s`]).
         ramp_up_full_scale_s: soft_start_full_scale_s(envelope, reference.ramp_up_full_scale_s),
@@ -448,26 +476,21 @@ pub fn controller_settings(scene: &Scene<'_>) -> Settings {
         // The datasheet's noise until a tare measures it (`Station::tune_to_cells`).
         normal_noise_n: declared_noise(&scene.normal_cell),
         tangential_noise_n: declared_noise(&scene.tangential_cell),
-        model_mismatch: DECLARED_MODEL_MISMATCH,
+        model_mismatch: mismatch,
         design_load_n: scene.contents.load_min_n,
         ..reference
     };
     // A scene with an overshoot criterion stages each step's feedforward so that a plant of
-    // the declared mismatch cannot pass it ([`staged_response_time_constant_s`]), and the lead
-    // then asks the envelope for the staged amplitude within one control period.
+    // the declared mismatch cannot pass it, and the lead then asks the envelope for the
+    // staged amplitude within one control period ([`drive_lead_s`]).
     let step_overshoot = overshoot_criterion(scene);
     let settings = Settings {
         step_overshoot,
-        response_time_constant_s: staged_response_time_constant_s(
-            step_overshoot,
-            settings.period_s,
-            settings.response_time_constant_s,
-            envelope,
-        ),
+        response_time_constant_s: drive_lead_s(&settings, step_overshoot),
         ..settings
     };
-    // The scene schema bounds the noise to [0, 10] % FS and the loads to positive values,
-    // and the mismatch is the constant above: the rule accepts them.
+    // The scene schema bounds the noise to [0, 10] % FS, the loads to positive values and
+    // the declared mismatch to [0, 1): the rule accepts them.
     tuned(&settings).unwrap_or(settings)
 }
 
@@ -688,6 +711,69 @@ mod tests {
             ..s
         };
         assert!(crate::control::Config::new(&bad).is_err());
+    }
+
+    #[test]
+    fn a_larger_declared_mismatch_slows_the_lead_and_lowers_the_fast_gain() {
+        let scene = find("reference").expect("built in");
+        let at = |mismatch: Option<f64>| {
+            controller_settings(&crate::scene::Scene {
+                model_mismatch: mismatch,
+                ..*scene
+            })
+        };
+        // No key: the documented default, the shipped scenes' tuning unchanged.
+        let default = controller_settings(scene);
+        assert_eq!(scene.model_mismatch, None);
+        assert_eq!(default.model_mismatch, DECLARED_MODEL_MISMATCH);
+        assert_eq!(at(Some(DECLARED_MODEL_MISMATCH)), default);
+        // Declared 40 %: each step's feedforward staged to (1 + 0.05) / (1 + 0.4) = 0.75 of the
+        // step at once (0.875 at 20 %; `control/stage.rs`), the lead the same (it asks for the
+        // staged amplitude within a period whatever the mismatch), the fast gain's sampled cap
+        // (1 - 0.4 - 0.3) / T = 3000 /s (5000 /s at 20 %), the slowest contact the mismatch
+        // allows 1 / 0.6 of the model's (1 / 0.8 at 20 %), the hold three lags of the slower
+        // chain.
+        let wide = at(Some(0.4));
+        assert_eq!(wide.model_mismatch, 0.4);
+        assert_eq!(wide.step_overshoot, Some(0.05));
+        assert_eq!(
+            wide.response_time_constant_s,
+            default.response_time_constant_s
+        );
+        let staged_at_once = |s: &Settings| {
+            crate::control::Config::new(s)
+                .expect("accepted")
+                .stage
+                .map(|stage| stage.lead().to_f64())
+        };
+        let wide_lead = staged_at_once(&wide).expect("staged");
+        assert!((wide_lead - 0.75).abs() < 1e-9, "{wide_lead}");
+        let default_lead = staged_at_once(&default).expect("staged");
+        assert!((default_lead - 0.875).abs() < 1e-9, "{default_lead}");
+        assert!(
+            (wide.ki_fast_per_s - 3_000.0).abs() < 1e-6,
+            "{}",
+            wide.ki_fast_per_s
+        );
+        assert!((default.ki_fast_per_s - 5_000.0).abs() < 1e-6);
+        assert!((wide.contact_lag_s / default.contact_lag_s - 0.8 / 0.6).abs() < 1e-12);
+        assert!(wide.boost_hold_s > default.boost_hold_s);
+        assert_eq!(tuned(&wide), Ok(wide));
+        // Declared 5 %: within the 5 % overshoot criterion, the step needs no staging (the
+        // whole step at once cannot pass it); the sampled cap rises to (1 - 0.05 - 0.3) / T =
+        // 6500 /s, still below the reference noise's limit m / (sigma_r sqrt(tau_L T)).
+        let narrow = at(Some(0.05));
+        assert_eq!(staged_at_once(&narrow), None);
+        assert!(
+            (narrow.ki_fast_per_s - 6_500.0).abs() < 1e-6,
+            "{}",
+            narrow.ki_fast_per_s
+        );
+        assert!(noise_limited_ki_per_s(&narrow) > narrow.ki_fast_per_s);
+        // Every mismatch the schema allows gives settings the controller accepts.
+        for m in [0.0, 0.05, 0.2, 0.4, 0.69, 0.7, 0.9, 0.999] {
+            assert!(crate::control::Config::new(&at(Some(m))).is_ok(), "{m}");
+        }
     }
 
     #[test]

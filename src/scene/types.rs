@@ -73,6 +73,11 @@ pub struct Scene<'a> {
     /// `commission` (`crate::commission`) measures f0, Q and mu0 on the simulated rig, and the
     /// controller runs on them instead of the declared `transducer` and `controller` values.
     pub commission: bool,
+    /// The model mismatch the user declares (`[controller] model_mismatch_pct` / 100), a
+    /// fraction in [0, 1): the plant's friction reduction may differ from the controller
+    /// model's by this share. The tuning ([`crate::control::controller_settings`]) designs the
+    /// loop for it; `None` (no key) takes [`crate::control::DECLARED_MODEL_MISMATCH`].
+    pub model_mismatch: Option<f64>,
 }
 
 impl Scene<'_> {

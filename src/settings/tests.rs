@@ -481,7 +481,12 @@ fn applied_commissioned_values_are_what_the_loop_runs_on() {
     assert_eq!(station.commissioned(), Some(result));
     assert_eq!(
         s,
-        crate::station::commissioned_settings(&declared, &result).expect("tuned")
+        crate::station::commissioned_settings(
+            &declared,
+            &result,
+            crate::control::overshoot_criterion(scene)
+        )
+        .expect("tuned")
     );
     assert_eq!(s.envelope_time_constant_s, result.time_constant_s.value);
     assert_eq!(s.natural_prior, result.natural_coefficient.value);

@@ -7,7 +7,9 @@ use super::Station;
 use crate::commission::{
     CellZero, CommissionResult, Commissioning, PeriodInputs, Phase, Refusal, Step, check,
 };
-use crate::control::{Config, Output, Settings, tuned};
+use crate::control::{
+    Config, GainSchedule, Output, Settings, ShaperConfig, drive_lead_s, gain_schedule, tuned,
+};
 use crate::drive::{Amplitude, Frequency};
 use crate::fx::{Q1_31, Q16_16};
 use crate::protocol::{Command, ProtocolError, SupervisorState};
@@ -20,14 +22,21 @@ use crate::sense::{Calibration, SensorChannel};
 pub(super) struct CommissionState {
     last: LastCommission,
     applied: Option<CommissionResult>,
+    /// The scene's tightest overshoot criterion ([`crate::control::overshoot_criterion`]):
+    /// the lead on the measured envelope is bounded by it as the declared tuning's is.
+    overshoot: Option<f64>,
 }
 
 impl CommissionState {
-    /// No `commission` given, the declared values.
-    pub(super) const NEVER: Self = Self {
-        last: LastCommission::Never,
-        applied: None,
-    };
+    /// No `commission` given, the declared values, for a scene whose tightest overshoot
+    /// criterion is `overshoot` (fraction of the step).
+    pub(super) const fn never(overshoot: Option<f64>) -> Self {
+        Self {
+            last: LastCommission::Never,
+            applied: None,
+            overshoot,
+        }
+    }
 }
 
 /// The state of the last `commission`.
@@ -38,8 +47,36 @@ enum LastCommission {
     Never,
     /// Running.
     Running(Commissioning),
+    /// The sequence ended with this result, which is being put into the loop one stage per
+    /// control period ([`ApplyStage`]); the drive stays off.
+    Applying(CommissionResult, ApplyStage),
     /// Finished: the result, or why there is none.
     Finished(Result<CommissionResult, Refusal>),
+}
+
+/// Putting a commissioning result into the loop, one stage per control period: the tuning
+/// rule on the measured values ([`commissioned_settings`]: square roots, a logarithm,
+/// divisions), then the controller's gain schedule ([`gain_schedule`]), then its drive shaper
+/// on the measured envelope ([`ShaperConfig::new`]), then the rest of its configuration from
+/// the running one ([`Config::commissioned`]: the contact lag, the ceiling at f0, mu0's
+/// prior; the force filters and the rest are unchanged), then the swap. Done in the one
+/// period the sequence ended in, the three made that period the only one of a console
+/// `commission` to overrun in the QEMU serve mode (a control part of 5,861 SysTick cycles,
+/// 145 us past its deadline at 10 kHz; `scripts/qemu-settings-test reset`'s commissioning
+/// session logs it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum ApplyStage {
+    /// Next: the settings on the measured values.
+    Settings,
+    /// Next: the gain schedule of these settings.
+    Gains(Settings),
+    /// Next: the drive shaper of these settings (the measured envelope and the lead).
+    Shaper(Settings, GainSchedule),
+    /// Next: the rest of the configuration of these settings, from the running one
+    /// ([`Config::commissioned`]).
+    Config(Settings, GainSchedule, ShaperConfig),
+    /// Next: swap these into the controller, pin the drive at f0.
+    Install(Settings, Config),
 }
 
 /// What the station reports of commissioning (`status`, the `commission` reply).
@@ -123,13 +160,20 @@ impl Station {
 
     /// Whether commissioning is running (the station reports `tuning`).
     pub(super) fn commissioning(&self) -> bool {
-        matches!(self.commission.last, LastCommission::Running(_))
+        matches!(
+            self.commission.last,
+            LastCommission::Running(_) | LastCommission::Applying(..)
+        )
     }
 
     /// `stop` during commissioning: it ends, refused, drive off, the resonance loop pinned.
     pub(super) fn cancel_commission(&mut self) {
-        if let LastCommission::Running(sequence) = &self.commission.last {
-            let step = sequence.step();
+        let step = match &self.commission.last {
+            LastCommission::Running(sequence) => Some(sequence.step()),
+            LastCommission::Applying(..) => Some(Step::Natural),
+            _ => None,
+        };
+        if let Some(step) = step {
             self.commission.last =
                 LastCommission::Finished(Err(Refusal::new(step, "stopped", f64::NAN)));
             self.pin_here();
@@ -153,6 +197,15 @@ impl Station {
         tangential_force: Q16_16,
         sliding_velocity_m_per_s: f32,
     ) {
+        if let LastCommission::Applying(result, stage) = self.commission.last {
+            self.commission.last = self.apply_stage(result, stage);
+            if output.fault.is_none() {
+                output.amplitude = Amplitude::ZERO;
+                self.controller.drive_replaced(Q1_31::ZERO);
+            }
+            self.applied = output.amplitude;
+            return;
+        }
         let LastCommission::Running(sequence) = &mut self.commission.last else {
             return;
         };
@@ -177,12 +230,14 @@ impl Station {
                 Amplitude::ZERO
             }
             Phase::Off => Amplitude::ZERO,
-            Phase::Done(result) => {
-                let result = result.and_then(|r| self.apply_commission(&r).map(|()| r));
-                if result.is_err() {
-                    self.pin_here();
-                }
-                self.commission.last = LastCommission::Finished(result);
+            Phase::Done(Ok(result)) => {
+                // Applied over the next periods ([`ApplyStage`]).
+                self.commission.last = LastCommission::Applying(result, ApplyStage::Settings);
+                Amplitude::ZERO
+            }
+            Phase::Done(Err(refusal)) => {
+                self.pin_here();
+                self.commission.last = LastCommission::Finished(Err(refusal));
                 Amplitude::ZERO
             }
         };
@@ -194,25 +249,79 @@ impl Station {
         self.applied = output.amplitude;
     }
 
+    /// One stage of putting `result` into the loop ([`ApplyStage`]): the state after it. A
+    /// refusal pins the drive where it is and ends the command refused.
+    fn apply_stage(&mut self, result: CommissionResult, stage: ApplyStage) -> LastCommission {
+        let next = match stage {
+            ApplyStage::Settings => self
+                .commission_settings(&result)
+                .map(|settings| Some(ApplyStage::Gains(settings))),
+            ApplyStage::Gains(settings) => gain_schedule(&settings)
+                .map(|gains| Some(ApplyStage::Shaper(settings, gains)))
+                .map_err(|_| refused_by_controller()),
+            ApplyStage::Shaper(settings, gains) => ShaperConfig::new(
+                settings.envelope_time_constant_s,
+                settings.response_time_constant_s,
+                settings.slew_full_scale_s,
+                settings.period_s,
+            )
+            .map(|shaper| Some(ApplyStage::Config(settings, gains, shaper)))
+            .map_err(|_| refused_by_controller()),
+            ApplyStage::Config(settings, gains, shaper) => self
+                .controller
+                .config()
+                .commissioned(&settings, gains, shaper)
+                .map(|config| Some(ApplyStage::Install(settings, config)))
+                .map_err(|_| refused_by_controller()),
+            ApplyStage::Install(settings, config) => self
+                .install_commission(&result, settings, config)
+                .map(|()| None),
+        };
+        match next {
+            Ok(Some(stage)) => LastCommission::Applying(result, stage),
+            Ok(None) => LastCommission::Finished(Ok(result)),
+            Err(refusal) => {
+                self.pin_here();
+                LastCommission::Finished(Err(refusal))
+            }
+        }
+    }
+
     /// The loop on the measured values, all or nothing ([`commissioned_settings`]): the
     /// controller's envelope time constant, its gains by the tuning rule with the measured
     /// noise and mu0, mu0 as the prior of the learned natural coefficient (the estimate starts
     /// there), the current ceiling at f0, the drive pinned at f0; the scene's nominal f0 and Q
-    /// (the detuning without a current sense) become the measured ones.
+    /// (the detuning without a current sense) become the measured ones. At once: for values
+    /// restored from the settings store (a console `commission` spreads the same stages over
+    /// control periods, [`ApplyStage`]).
     fn apply_commission(&mut self, result: &CommissionResult) -> Result<(), Refusal> {
-        let refused = |reason| Refusal::new(Step::Natural, reason, f64::NAN);
+        let settings = self.commission_settings(result)?;
+        let config = commission_config(&settings)?;
+        self.install_commission(result, settings, config)
+    }
+
+    /// [`ApplyStage::Settings`]: the result checked against its ranges, the settings on it.
+    fn commission_settings(&self, result: &CommissionResult) -> Result<Settings, Refusal> {
         check(result)?;
-        let settings = commissioned_settings(&self.settings, result)
-            .map_err(|_| refused("controller refused the values"))?;
-        let config =
-            Config::new(&settings).map_err(|_| refused("controller refused the values"))?;
+        commissioned_settings(&self.settings, result, self.commission.overshoot)
+            .map_err(|_| refused_by_controller())
+    }
+
+    /// [`ApplyStage::Install`]: the drive pinned at f0, the controller on `config`, the
+    /// station's f0 and Q the measured ones.
+    fn install_commission(
+        &mut self,
+        result: &CommissionResult,
+        settings: Settings,
+        config: Config,
+    ) -> Result<(), Refusal> {
         let f0 = result.resonance_hz.value;
         let millihertz = libm::round(f0 * 1e3) as u32;
         let mut resonance = self.resonance.clone();
         if let Some(resonance) = resonance.as_mut() {
             resonance
                 .pin(Frequency::from_millihertz(millihertz))
-                .map_err(|_| refused("the timer cannot make f0"))?;
+                .map_err(|_| Refusal::new(Step::Natural, "the timer cannot make f0", f64::NAN))?;
         }
         self.resonance = resonance;
         self.controller.reconfigure(config);
@@ -258,28 +367,44 @@ impl Station {
             (LastCommission::Never, None) => CommissionReport::Never,
             (LastCommission::Never, Some(result)) => CommissionReport::Restored(result),
             (LastCommission::Running(sequence), _) => CommissionReport::Running(sequence.step()),
+            // The sequence's last step ends when its result is in the loop.
+            (LastCommission::Applying(..), _) => CommissionReport::Running(Step::Natural),
             (LastCommission::Finished(Ok(result)), _) => CommissionReport::Done(*result),
             (LastCommission::Finished(Err(refusal)), _) => CommissionReport::Refused(*refusal),
         }
     }
 }
 
-/// `settings` on the commissioned values: the envelope time constant tau (and the lead, which
-/// cannot make it slower: `min(reference lead, tau)`, the rule of
+/// The refusal of values the controller does not accept.
+fn refused_by_controller() -> Refusal {
+    Refusal::new(Step::Natural, "controller refused the values", f64::NAN)
+}
+
+/// [`ApplyStage::Config`]: the controller's configuration of `settings`.
+fn commission_config(settings: &Settings) -> Result<Config, Refusal> {
+    Config::new(settings).map_err(|_| refused_by_controller())
+}
+
+/// `settings` on the commissioned values: the envelope time constant tau (and the lead on it,
+/// [`drive_lead_s`]: bounded for the settings' declared mismatch under the scene's tightest
+/// overshoot criterion `overshoot`, never slower than tau; the rule of
 /// [`crate::control::controller_settings`]), the drive frequency f0 (the current ceiling),
 /// mu0 as the prior of the natural coefficient, the contact's relaxation lag scaled with it
 /// (the slip length `mu W / k_t` is proportional to mu: [`crate::control::contact_lag_s`]),
 /// each cell's measured noise where the tare measured it, then the tuning rule
-/// ([`tuned`]) for the gains on all of them. Errors: the rule refused a value.
+/// ([`tuned`]) for the gains on all of them. The declared mismatch (`settings.model_mismatch`,
+/// the scene's) is kept: commissioning measures f0, Q, mu0 and the noise, not the model's
+/// error. Errors: the rule refused a value.
 pub fn commissioned_settings(
     settings: &Settings,
     result: &CommissionResult,
+    overshoot: Option<f64>,
 ) -> Result<Settings, crate::control::ConfigError> {
     let mut s = *settings;
     let tau = result.time_constant_s.value;
     let mu0 = result.natural_coefficient.value;
     s.envelope_time_constant_s = tau;
-    s.response_time_constant_s = libm::fmin(Settings::REFERENCE.response_time_constant_s, tau);
+    s.response_time_constant_s = drive_lead_s(&s, overshoot);
     s.actuator.drive_frequency_hz = result.resonance_hz.value;
     if s.natural_prior > 0.0 {
         s.contact_lag_s *= mu0 / s.natural_prior;
