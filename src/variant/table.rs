@@ -51,95 +51,95 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "Coulomb ratio",
-        instructions: 296.372,
+        instructions: 296.225,
     },
     Cost {
         variant: "Coulomb ratio f32 micromath",
-        instructions: 68.774,
+        instructions: 68.823,
     },
     Cost {
         variant: "Coulomb ratio f32 libm",
-        instructions: 259.362,
+        instructions: 259.019,
     },
     Cost {
         variant: "Coulomb ratio f64",
-        instructions: 2719.95,
+        instructions: 2720.098,
     },
     Cost {
         variant: "Dahl steady N=16",
-        instructions: 11363.494,
+        instructions: 11363.387,
     },
     Cost {
         variant: "Dahl steady N=16 f32 micromath",
-        instructions: 5869.408,
+        instructions: 5869.516,
     },
     Cost {
         variant: "Dahl steady N=16 f32 libm",
-        instructions: 31845.86,
+        instructions: 31845.697,
     },
     Cost {
         variant: "Dahl steady N=16 f64",
-        instructions: 147230.05,
+        instructions: 147230.27,
     },
     Cost {
         variant: "Dahl steady N=32",
-        instructions: 20291.506,
+        instructions: 20291.074,
     },
     Cost {
         variant: "Dahl steady N=32 f32 micromath",
-        instructions: 11294.462,
+        instructions: 11294.838,
     },
     Cost {
         variant: "Dahl steady N=32 f32 libm",
-        instructions: 58658.117,
+        instructions: 58658.547,
     },
     Cost {
         variant: "Dahl steady N=32 f64",
-        instructions: 269834.53,
+        instructions: 269834.94,
     },
     Cost {
         variant: "Dahl steady N=64",
-        instructions: 38005.754,
+        instructions: 38005.86,
     },
     Cost {
         variant: "Dahl steady N=64 f32 micromath",
-        instructions: 22175.912,
+        instructions: 22176.451,
     },
     Cost {
         variant: "Dahl steady N=64 f32 libm",
-        instructions: 111925.055,
+        instructions: 111924.46,
     },
     Cost {
         variant: "Dahl steady N=64 f64",
-        instructions: 511145.97,
+        instructions: 511147.84,
     },
     Cost {
         variant: "Dahl steady T=49x73",
-        instructions: 322.526,
+        instructions: 322.258,
     },
     Cost {
         variant: "cube el N=4",
-        instructions: 590.641,
+        instructions: 590.769,
     },
     Cost {
         variant: "cube el N=4 f32 micromath",
-        instructions: 378.076,
+        instructions: 377.948,
     },
     Cost {
         variant: "cube el N=4 f32 libm",
-        instructions: 263.012,
+        instructions: 263.076,
     },
     Cost {
         variant: "cube el N=4 f64",
-        instructions: 9437.82,
+        instructions: 9437.628,
     },
     Cost {
         variant: "cube el N=8",
-        instructions: 829.038,
+        instructions: 828.782,
     },
     Cost {
         variant: "cube el N=8 f32 micromath",
-        instructions: 631.858,
+        instructions: 632.051,
     },
     Cost {
         variant: "cube el N=8 f32 libm",
@@ -147,11 +147,11 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=8 f64",
-        instructions: 15243.525,
+        instructions: 15243.589,
     },
     Cost {
         variant: "cube el N=16",
-        instructions: 1304.871,
+        instructions: 1305.064,
     },
     Cost {
         variant: "cube el N=16 f32 micromath",
@@ -167,27 +167,27 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube el N=32",
-        instructions: 2257.115,
+        instructions: 2256.858,
     },
     Cost {
         variant: "cube el N=32 f32 micromath",
-        instructions: 2161.858,
+        instructions: 2161.923,
     },
     Cost {
         variant: "cube el N=32 f32 libm",
-        instructions: 1183.846,
+        instructions: 1183.91,
     },
     Cost {
         variant: "cube el N=32 f64",
-        instructions: 50148.14,
+        instructions: 50148.332,
     },
     Cost {
         variant: "cube el T=5x5",
-        instructions: 282.82,
+        instructions: 282.628,
     },
     Cost {
         variant: "cube el T=9x9",
-        instructions: 282.564,
+        instructions: 282.82,
     },
     Cost {
         variant: "cube el T=17x17",
@@ -195,51 +195,51 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=4",
-        instructions: 590.833,
+        instructions: 590.897,
     },
     Cost {
         variant: "cube ep N=4 f32 micromath",
-        instructions: 378.141,
+        instructions: 378.012,
     },
     Cost {
         variant: "cube ep N=4 f32 libm",
-        instructions: 263.141,
+        instructions: 263.012,
     },
     Cost {
         variant: "cube ep N=4 f64",
-        instructions: 9428.846,
+        instructions: 9428.91,
     },
     Cost {
         variant: "cube ep N=8",
-        instructions: 829.038,
+        instructions: 828.974,
     },
     Cost {
         variant: "cube ep N=8 f32 micromath",
-        instructions: 632.051,
+        instructions: 631.987,
     },
     Cost {
         variant: "cube ep N=8 f32 libm",
-        instructions: 393.525,
+        instructions: 393.589,
     },
     Cost {
         variant: "cube ep N=8 f64",
-        instructions: 15231.602,
+        instructions: 15231.474,
     },
     Cost {
         variant: "cube ep N=16",
-        instructions: 1305.0,
+        instructions: 1304.807,
     },
     Cost {
         variant: "cube ep N=16 f32 micromath",
-        instructions: 1141.923,
+        instructions: 1141.987,
     },
     Cost {
         variant: "cube ep N=16 f32 libm",
-        instructions: 657.435,
+        instructions: 657.628,
     },
     Cost {
         variant: "cube ep N=16 f64",
-        instructions: 26885.896,
+        instructions: 26885.832,
     },
     Cost {
         variant: "cube ep N=32",
@@ -247,27 +247,27 @@ static COSTS: &[Cost] = &[
     },
     Cost {
         variant: "cube ep N=32 f32 micromath",
-        instructions: 2161.794,
+        instructions: 2161.858,
     },
     Cost {
         variant: "cube ep N=32 f32 libm",
-        instructions: 1183.846,
+        instructions: 1183.717,
     },
     Cost {
         variant: "cube ep N=32 f64",
-        instructions: 50137.242,
+        instructions: 50137.63,
     },
     Cost {
         variant: "cube ep T=5x5",
-        instructions: 282.884,
+        instructions: 282.692,
     },
     Cost {
         variant: "cube ep T=9x9",
-        instructions: 282.756,
+        instructions: 282.82,
     },
     Cost {
         variant: "cube ep T=17x17",
-        instructions: 282.82,
+        instructions: 282.564,
     },
 ];
 
@@ -1253,97 +1253,97 @@ static ERRORS: &[SceneError] = &[
 static STEPS: &[StepCost] = &[
     StepCost {
         variant: "Coulomb ratio",
-        mean: 2845.12,
-        longest: 3160,
+        mean: 3011.68,
+        longest: 3320,
     },
     StepCost {
         variant: "Dahl steady N=16",
-        mean: 210106.72,
-        longest: 262040,
+        mean: 209985.77,
+        longest: 261760,
     },
     StepCost {
         variant: "Dahl steady N=32",
-        mean: 380164.63,
-        longest: 473800,
+        mean: 379439.2,
+        longest: 473440,
     },
     StepCost {
         variant: "Dahl steady N=64",
-        mean: 715157.75,
-        longest: 891720,
+        mean: 713390.9,
+        longest: 892000,
     },
     StepCost {
         variant: "Dahl steady T=49x73",
-        mean: 3499.84,
-        longest: 4160,
+        mean: 3664.48,
+        longest: 4400,
     },
     StepCost {
         variant: "cube el N=4",
-        mean: 4339.145,
-        longest: 5920,
+        mean: 4504.527,
+        longest: 6080,
     },
     StepCost {
         variant: "cube el N=8",
-        mean: 5328.294,
-        longest: 7400,
+        mean: 5494.12,
+        longest: 7560,
     },
     StepCost {
         variant: "cube el N=16",
-        mean: 7306.458,
-        longest: 10440,
+        mean: 7471.938,
+        longest: 10600,
     },
     StepCost {
         variant: "cube el N=32",
-        mean: 11263.003,
-        longest: 16480,
+        mean: 11428.094,
+        longest: 16680,
     },
     StepCost {
         variant: "cube el T=5x5",
-        mean: 3366.24,
-        longest: 3480,
+        mean: 3531.192,
+        longest: 3640,
     },
     StepCost {
         variant: "cube el T=9x9",
-        mean: 3391.93,
-        longest: 3520,
+        mean: 3557.567,
+        longest: 3680,
     },
     StepCost {
         variant: "cube el T=17x17",
-        mean: 3400.814,
-        longest: 3560,
+        mean: 3565.876,
+        longest: 3720,
     },
     StepCost {
         variant: "cube ep N=4",
-        mean: 4339.287,
-        longest: 5880,
+        mean: 4505.305,
+        longest: 6040,
     },
     StepCost {
         variant: "cube ep N=8",
-        mean: 5329.996,
-        longest: 7440,
+        mean: 5496.05,
+        longest: 7600,
     },
     StepCost {
         variant: "cube ep N=16",
-        mean: 7308.683,
-        longest: 10440,
+        mean: 7474.109,
+        longest: 10600,
     },
     StepCost {
         variant: "cube ep N=32",
-        mean: 11265.356,
-        longest: 16520,
+        mean: 11430.378,
+        longest: 16680,
     },
     StepCost {
         variant: "cube ep T=5x5",
-        mean: 3366.323,
-        longest: 3480,
+        mean: 3532.0,
+        longest: 3640,
     },
     StepCost {
         variant: "cube ep T=9x9",
-        mean: 3392.694,
-        longest: 3520,
+        mean: 3558.567,
+        longest: 3640,
     },
     StepCost {
         variant: "cube ep T=17x17",
-        mean: 3400.883,
-        longest: 3520,
+        mean: 3566.829,
+        longest: 3680,
     },
 ];
