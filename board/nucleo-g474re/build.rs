@@ -172,7 +172,8 @@ fn scene_start(out: &Path) {
              controller: {:?},\n        actuator: {:?},\n        horn: {:?},\n        \
              transducer: {:?},\n        normal_cell: {:?},\n        tangential_cell: {:?},\n        \
              sliding_velocity_m_per_s: &{:?},\n        accuracy: {:?},\n        contents: {:?},\n        \
-             commission: {:?},\n    }},\n    settings: &SETTINGS_{index},\n    findings: &[",
+             commission: {:?},\n        model_mismatch: {:?},\n        overshoot: &[{}],\n    }},\n    \
+             settings: &SETTINGS_{index},\n    findings: &[",
             record.system,
             record.control_rate_hz,
             record.duration_s,
@@ -186,6 +187,18 @@ fn scene_start(out: &Path) {
             record.accuracy,
             record.contents,
             record.commission,
+            record.model_mismatch,
+            record
+                .overshoot
+                .iter()
+                .map(|criterion| match criterion {
+                    sonolube::scene::Criterion::Overshoot { max_pct } => {
+                        format!("Criterion::Overshoot {{ max_pct: {max_pct:?} }}")
+                    }
+                    other => panic!("not an overshoot criterion: {other:?}"),
+                })
+                .collect::<Vec<_>>()
+                .join(", "),
         );
         for finding in findings.findings() {
             let _ = write!(starts, "{finding:?}, ");

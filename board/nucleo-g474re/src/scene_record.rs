@@ -11,8 +11,8 @@
 //! Compiled into the build script as well (`build.rs`).
 
 use sonolube::scene::{
-    Accuracy, Actuator, Breakpoint, Contents, Horn, LoadCell, Mismatch, ModelSpec, Scene, System,
-    Transducer,
+    Accuracy, Actuator, Breakpoint, Contents, Criterion, Horn, LoadCell, Mismatch, ModelSpec,
+    Scene, System, Transducer,
 };
 
 /// What the board keeps of a built-in scene (see the module's documentation).
@@ -44,6 +44,11 @@ pub struct SceneRecord {
     pub contents: Contents,
     /// The scene's run uses commissioned values.
     pub commission: bool,
+    /// The model mismatch the scene declares (`[controller] model_mismatch_pct`), a fraction.
+    pub model_mismatch: Option<f64>,
+    /// The scene's tightest overshoot criterion alone (the station designs a console
+    /// commissioning's staged steps by it), or none.
+    pub overshoot: &'static [Criterion],
 }
 
 /// The plant over controller mismatch of a scene whose plant is the controller's own model.
@@ -57,6 +62,20 @@ impl SceneRecord {
     /// The record of `scene` (the build script's).
     #[allow(dead_code)]
     pub fn of(scene: &Scene<'static>) -> Self {
+        // The tightest overshoot criterion, as a one-element slice of the scene's own.
+        let tightest = scene
+            .criteria
+            .iter()
+            .enumerate()
+            .filter_map(|(index, criterion)| match criterion {
+                Criterion::Overshoot { max_pct } => Some((index, *max_pct)),
+                _ => None,
+            })
+            .reduce(|a, b| if b.1 < a.1 { b } else { a });
+        let overshoot = match tightest {
+            Some((index, _)) => &scene.criteria[index..=index],
+            None => &[],
+        };
         Self {
             system: scene.system,
             control_rate_hz: scene.control_rate_hz,
@@ -71,6 +90,8 @@ impl SceneRecord {
             accuracy: scene.accuracy,
             contents: scene.contents,
             commission: scene.commission,
+            model_mismatch: scene.model_mismatch,
+            overshoot,
         }
     }
 
@@ -102,9 +123,10 @@ impl SceneRecord {
             sliding_velocity_m_per_s: self.sliding_velocity_m_per_s,
             target: &[],
             accuracy: self.accuracy,
-            criteria: &[],
+            criteria: self.overshoot,
             contents: self.contents,
             commission: self.commission,
+            model_mismatch: self.model_mismatch,
         }
     }
 }

@@ -13,8 +13,8 @@ use sonolube::control::Settings;
 use sonolube::scene::feasibility::{Cause::*, Finding, Severity::*};
 #[allow(unused_imports)]
 use sonolube::scene::{
-    Accuracy, Actuator, ActuatorKind::*, Breakpoint, Contents, Horn, LoadCell, ModelKind::*,
-    ModelSpec, ResonanceShift, RoughSurface, Stack, System::*, Transducer,
+    Accuracy, Actuator, ActuatorKind::*, Breakpoint, Contents, Criterion, Horn, LoadCell,
+    ModelKind::*, ModelSpec, ResonanceShift, RoughSurface, Stack, System::*, Transducer,
 };
 use sonolube::variant::Selection;
 #[allow(unused_imports)]
