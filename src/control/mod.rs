@@ -170,8 +170,9 @@ pub use target::{ForceQ, PreparedTarget};
 pub use tuning::{
     DECLARED_MODEL_MISMATCH, FORCE_FILTER_HZ, HOLD_LAG_MULTIPLE, MAX_STAGED_LEAD_GAIN,
     NATURAL_LEARN_S, NATURAL_PRIOR_WEIGHT, SLIDING_DEBOUNCE_S, STEADY_GAINS, VELOCITY_FILTER_HZ,
-    contact_lag_s, controller_settings, declared_mismatch, drive_lead_s, low_pass_variance_share,
-    noise_limited_ki_per_s, noise_rms_error, observation_lag_s, overshoot_criterion, ratio_noise,
-    sampled_ki_cap_per_s, soft_start_full_scale_s, staged_response_time_constant_s,
-    steady_noise_rms_error, steady_noise_share, tuned,
+    contact_lag_s, controller_settings, declared_mismatch, drive_lead_s, learning_samples,
+    low_pass_variance_share, natural_learning_error, noise_limited_ki_per_s, noise_rms_error,
+    observation_lag_s, overshoot_criterion, ratio_noise, sampled_ki_cap_per_s,
+    soft_start_full_scale_s, staged_response_time_constant_s, steady_noise_rms_error,
+    steady_noise_share, tuned,
 };

@@ -299,24 +299,50 @@ pub fn steady_noise_rms_error(
     load_n: f64,
     learn_s: f64,
 ) -> f64 {
-    let relative = |force_noise: f64, force: f64| {
-        if force > 0.0 {
-            force_noise / force
-        } else {
-            f64::INFINITY
-        }
-    };
-    let normal = relative(normal_noise_n, load_n);
-    let measured = libm::hypot(relative(tangential_noise_n, friction_n), normal);
-    let natural = libm::hypot(
-        relative(tangential_noise_n, s.natural_prior * load_n),
-        normal,
-    );
-    let samples = libm::fmax(libm::floor(learn_s / s.period_s), 1.0);
+    let normal = relative_noise(normal_noise_n, load_n);
+    let measured = libm::hypot(relative_noise(tangential_noise_n, friction_n), normal);
     libm::hypot(
         measured * steady_noise_share(s),
-        natural / libm::sqrt(samples),
+        natural_learning_error(
+            tangential_noise_n,
+            normal_noise_n,
+            s.natural_prior,
+            load_n,
+            learning_samples(s, learn_s),
+        ),
     )
+}
+
+/// A force's per-sample noise relative to the force; infinite for a force that is not positive.
+fn relative_noise(force_noise_n: f64, force_n: f64) -> f64 {
+    if force_n > 0.0 {
+        force_noise_n / force_n
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The samples mu0 is learned from in `learn_s` at the control period: at least one.
+pub fn learning_samples(s: &Settings, learn_s: f64) -> f64 {
+    libm::fmax(libm::floor(learn_s / s.period_s), 1.0)
+}
+
+/// mu0's relative standard error after `samples` samples of the coefficient `F_t / F_n`,
+/// taken sliding with the drive off at the natural coefficient `mu0` under `load_n`, from cells
+/// of per-sample noise `tangential_noise_n` and `normal_noise_n` (N RMS):
+/// `sqrt((sigma_t / (mu0 W))^2 + (sigma_n / W)^2) / sqrt(n)`. A reduction or ratio target is
+/// relative to mu0, so this is a steady error of the held friction no feedback sees.
+pub fn natural_learning_error(
+    tangential_noise_n: f64,
+    normal_noise_n: f64,
+    mu0: f64,
+    load_n: f64,
+    samples: f64,
+) -> f64 {
+    libm::hypot(
+        relative_noise(tangential_noise_n, mu0 * load_n),
+        relative_noise(normal_noise_n, load_n),
+    ) / libm::sqrt(samples)
 }
 
 /// The fast integral gain the noise allows, 1/s: the steady gain of a Kalman-Bucy filter of

@@ -648,12 +648,10 @@ fn noise(scene: &Scene<'_>, settings: &Settings) -> Option<Finding> {
     let normal = cell_noise_n(&scene.normal_cell);
     let band = scene.accuracy.friction_pct;
     let mut worst: Option<(f64, Cause, &'static str)> = None;
-    // mu0 is learned sliding with the drive off, from the sliding debounce until the drive
-    // first starts (at least the controller's `natural_learn_s`).
-    let mut learn_s: Option<f64> = None;
+    // mu0 is learned sliding with the drive off until the drive first starts.
+    let (learn_s, _) = learning(scene, settings)?;
     for instant in loop_instants(scene, settings) {
         let TargetInstant {
-            t_s: t,
             load_n: load,
             needed,
             mu,
@@ -664,10 +662,6 @@ fn noise(scene: &Scene<'_>, settings: &Settings) -> Option<Finding> {
             continue;
         }
         let friction = needed * mu * load;
-        let learn_s = *learn_s.get_or_insert(libm::fmax(
-            t - settings.sliding_debounce_s,
-            settings.natural_learn_s,
-        ));
         // Through the loop: the steady PI's share of the measured ratio's noise and mu0's
         // learning error (`control::steady_noise_rms_error`).
         let predicted = 100.0
@@ -707,24 +701,20 @@ fn noise(scene: &Scene<'_>, settings: &Settings) -> Option<Finding> {
     })
 }
 
-/// The time mu0 is learned before the drive first starts, s: from the sliding debounce to the
-/// first target point that asks for drive while the contact slides, at least the controller's
-/// `natural_learn_s` (the drive waits for it). `None` when no target asks for drive.
-fn learning_s(scene: &Scene<'_>, settings: &Settings) -> Option<f64> {
-    scene.target.iter().find_map(|point| {
-        let speed = speed_at(scene, point.at_s);
-        let load = f64::from(interpolate(scene.normal_load_n, point.at_s as f32));
-        let mu = scene.controller.natural_coefficient(speed);
-        (speed > settings.sliding_on_m_s
-            && load > settings.min_normal_force_n
-            && needed_ratio(point.target, mu, load) < 1.0)
-            .then(|| {
-                libm::fmax(
-                    point.at_s - settings.sliding_debounce_s,
-                    settings.natural_learn_s,
-                )
-            })
-    })
+/// How long mu0 is learned before the drive first starts, s, and the instant the drive starts:
+/// from the sliding debounce to the first instant the loop runs at which a target asks for
+/// drive ([`loop_instants`]), at least the controller's `natural_learn_s` (the drive waits for
+/// it). `None` when no target asks for drive.
+fn learning(scene: &Scene<'_>, settings: &Settings) -> Option<(f64, TargetInstant)> {
+    loop_instants(scene, settings)
+        .find(|instant| instant.needed < 1.0)
+        .map(|instant| {
+            let learn_s = libm::fmax(
+                instant.t_s - settings.sliding_debounce_s,
+                settings.natural_learn_s,
+            );
+            (learn_s, instant)
+        })
 }
 
 /// Every reduction step after the first drive against mu0's standard error (module docs):
@@ -732,28 +722,27 @@ fn learning_s(scene: &Scene<'_>, settings: &Settings) -> Option<f64> {
 /// `None` without an overshoot criterion or a reduction step.
 fn step_resolution(scene: &Scene<'_>, settings: &Settings) -> Option<Finding> {
     let overshoot = crate::control::overshoot_criterion(scene)?;
-    let learn_s = learning_s(scene, settings)?;
-    let samples = libm::fmax(libm::floor(learn_s / settings.period_s), 1.0);
-    let tangential = cell_noise_n(&scene.tangential_cell);
-    let normal = cell_noise_n(&scene.normal_cell);
-    // mu0's relative standard error, at the load and speed it is learned at.
-    let at_learning = |t: f64| {
-        let load = f64::from(interpolate(scene.normal_load_n, t as f32));
-        let mu = scene.controller.natural_coefficient(speed_at(scene, t));
-        libm::hypot(tangential / (mu * load), normal / load) / libm::sqrt(samples)
-    };
-    // The drive starts when the learning ends.
+    let (learn_s, drive_start) = learning(scene, settings)?;
+    let samples = crate::control::learning_samples(settings, learn_s);
+    // mu0's relative standard error, at the load and speed where the drive starts.
+    let natural_error = crate::control::natural_learning_error(
+        cell_noise_n(&scene.tangential_cell),
+        cell_noise_n(&scene.normal_cell),
+        drive_start.mu,
+        drive_start.load_n,
+        samples,
+    );
     let drive_start_s = settings.sliding_debounce_s + learn_s;
-    let natural_error = at_learning(drive_start_s);
-    let mut worst: Option<Cause> = None;
+    let mut worst: Option<(f64, Cause)> = None;
     for (index, pair) in scene.target.windows(2).enumerate() {
         let [before, after] = pair else { continue };
         if !matches!(after.target, Target::Reduction { .. }) || after.at_s + 1e-9 < drive_start_s {
             continue;
         }
-        let speed = speed_at(scene, after.at_s);
         let load = f64::from(interpolate(scene.normal_load_n, after.at_s as f32));
-        let mu = scene.controller.natural_coefficient(speed);
+        let mu = scene
+            .controller
+            .natural_coefficient(speed_at(scene, after.at_s));
         let (from, to) = (
             needed_ratio(before.target, mu, load),
             needed_ratio(after.target, mu, load),
@@ -763,14 +752,8 @@ fn step_resolution(scene: &Scene<'_>, settings: &Settings) -> Option<Finding> {
             continue;
         }
         let offset = to * natural_error / step;
-        let worse = match worst {
-            Some(Cause::StepBelowResolution {
-                offset_pct_of_step, ..
-            }) => 100.0 * offset > offset_pct_of_step,
-            _ => true,
-        };
-        if worse {
-            worst = Some(Cause::StepBelowResolution {
+        if worst.is_none_or(|(worst_offset, _)| offset > worst_offset) {
+            let cause = Cause::StepBelowResolution {
                 point: index + 1,
                 step_pct: 100.0 * step,
                 natural_error_pct: 100.0 * natural_error,
@@ -778,19 +761,12 @@ fn step_resolution(scene: &Scene<'_>, settings: &Settings) -> Option<Finding> {
                 offset_pct_of_step: 100.0 * offset,
                 overshoot_pct: 100.0 * overshoot,
                 chance_past: 0.5 * libm::erfc(overshoot / offset / core::f64::consts::SQRT_2),
-            });
+            };
+            worst = Some((offset, cause));
         }
     }
-    let cause = worst?;
-    let Cause::StepBelowResolution {
-        offset_pct_of_step,
-        overshoot_pct,
-        ..
-    } = cause
-    else {
-        return None;
-    };
-    (offset_pct_of_step > overshoot_pct / 2.0).then_some(Finding {
+    let (offset, cause) = worst?;
+    (offset > overshoot / 2.0).then_some(Finding {
         severity: Severity::Warn,
         field: "profiles.target",
         cause,
